@@ -1,0 +1,118 @@
+// The plain description of a run that the engine executes. tools/ fills it from a YAML file;
+// tests and benchmarks build it in code. SI units throughout. No I/O here.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sph/kernels.hpp"
+
+namespace turbid::fsi {
+
+using Vec3d = std::array<double, 3>;  // 2D scenes leave the third component 0
+
+// Where a value came from, so that errors found after parsing can still name file:line:column.
+struct SourceLocation {
+  std::string file;
+  int line = 0;    // 1-based; 0 when the value was not read from a file
+  int column = 0;  // 1-based
+};
+
+enum class DiffusionKind { none, molteni, antuono, fourtakas };
+enum class ViscosityKind { artificial, laminar };
+
+struct MaterialSpec {
+  std::string name;
+  std::string model = "newtonian";  // later: bingham, herschel_bulkley
+  double density = 1000.0;          // rest density rho0 [kg/m^3]
+  double viscosity = 1.0e-3;        // dynamic viscosity [Pa s]
+  double sound_speed = 0.0;         // c0 [m/s]; 0 = automatic (10 x sqrt(2 g H_max))
+  double gamma = 7.0;               // Tait exponent [-]
+  double background_pressure = 0.0; // p_b [Pa]
+  SourceLocation where;
+};
+
+struct Box {
+  Vec3d min{0, 0, 0};
+  Vec3d max{0, 0, 0};
+};
+
+struct FluidBlock {
+  std::string material;
+  Box box;
+  SourceLocation where;
+};
+
+struct WallSpec {
+  enum class Kind {
+    container,  // layers of particles outside the faces of `box` (a tank); faces in `open` are left out
+    solid_box,  // `box` filled with boundary particles (an obstacle)
+    polyline,   // 2D: a chain of segments through `points`, layers on the side given by `side`
+  };
+  Kind kind = Kind::container;
+  Box box;
+  // container faces left open, in the order -x, +x, -y, +y, -z, +z
+  std::array<bool, 6> open{false, false, false, false, false, false};
+  std::vector<Vec3d> points;  // polyline vertices (2D)
+  bool closed = false;        // polyline: connect the last point to the first
+  int side = -1;              // polyline: layers on the right (-1) or left (+1) of the direction of travel
+  int layers = 0;             // number of particle layers; 0 = enough for the kernel support
+  SourceLocation where;
+};
+
+struct ProbeSpec {
+  enum class Type {
+    front_position,  // largest coordinate along `axis` reached by fluid of `material` [m]
+    pressure,        // kernel (Shepard) interpolated fluid pressure at `point` [Pa]
+    max_speed,       // largest fluid particle speed [m/s]
+    kinetic_energy,  // total fluid kinetic energy [J] (per metre of depth in 2D)
+    fluid_particles, // number of fluid particles [-]
+  };
+  std::string name;
+  Type type = Type::max_speed;
+  std::string material;  // front_position: empty = any fluid
+  int axis = 0;          // front_position: 0 = x, 1 = y, 2 = z
+  Vec3d point{0, 0, 0};  // pressure
+  SourceLocation where;
+};
+
+struct OutputSpec {
+  double every = 0.0;           // output interval [s]; 0 = only the initial and final state
+  bool vtk = true;              // write particles_NNNN.vtp and particles.pvd
+  double checkpoint_every = 0;  // [s]; 0 = no checkpoints
+};
+
+struct NumericsSpec {
+  sph::KernelKind kernel = sph::KernelKind::wendland_c2;
+  DiffusionKind diffusion = DiffusionKind::fourtakas;
+  double diffusion_delta = 0.1;            // delta of the density diffusion term [-]
+  ViscosityKind viscosity = ViscosityKind::artificial;
+  double artificial_viscosity = 0.01;      // Monaghan alpha [-]
+  double cfl = 0.2;                        // Courant number for the acoustic and force limits [-]
+  double viscous_dt_factor = 0.125;        // dt <= factor h^2 / nu_max (Morris et al. 1997)
+  double min_time_step = 1.0e-9;           // a smaller dt stops the run as collapsed [s]
+  double density_ratio_limit = 0.5;        // |rho/rho0 - 1| above this stops the run [-]
+};
+
+struct Scene {
+  std::string name;
+  std::string source_file;  // the YAML file, for messages; empty when built in code
+  int dimensions = 2;
+  double particle_spacing = 0.01;  // dx [m]
+  double smoothing_ratio = 1.3;    // h = smoothing_ratio * dx
+  double end_time = 1.0;           // [s]
+  Vec3d gravity{0, -9.81, 0};      // [m/s^2]
+  NumericsSpec numerics;
+  std::vector<MaterialSpec> materials;
+  std::vector<FluidBlock> fluids;
+  std::vector<WallSpec> walls;
+  std::vector<ProbeSpec> probes;
+  OutputSpec output;
+  // Particles leaving this box are removed and counted. Default: the bounding box of all
+  // initial particles, grown by 10% of its size on every side.
+  std::optional<Box> domain;
+};
+
+}  // namespace turbid::fsi

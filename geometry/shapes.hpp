@@ -1,0 +1,31 @@
+// Point sets sampled from simple shapes: lattices filling boxes, wall layers around boxes and along
+// 2D polylines. Points carry no physics; the caller decides what they become.
+#pragma once
+#include <array>
+#include <vector>
+
+namespace turbid::geometry {
+
+using Point = std::array<double, 3>;
+
+struct Aabb {
+  Point min{0, 0, 0};
+  Point max{0, 0, 0};
+};
+
+// Cell-centred lattice points (spacing dx) inside [min, max] in the first `dims` axes.
+std::vector<Point> fill_box(const Aabb& box, double dx, int dims);
+
+// `layers` layers of lattice points outside the faces of `box` (a tank), continuing the
+// cell-centred lattice of fill_box so that wall and fluid particles are exactly dx apart.
+// open[2k] / open[2k+1] leave out the -/+ face of axis k; corners and edges are filled
+// when both adjacent faces are closed.
+std::vector<Point> container_walls(const Aabb& box, double dx, int dims, int layers,
+                                   const std::array<bool, 6>& open);
+
+// 2D: points along a polyline at spacing ~dx, `layers` rows offset by dx to one side
+// (side = -1: right of the direction of travel, +1: left), the first row dx/2 from the line.
+std::vector<Point> polyline_walls(const std::vector<Point>& vertices, bool closed, double dx, int layers,
+                                  int side);
+
+}  // namespace turbid::geometry
