@@ -1,0 +1,106 @@
+// Probe evaluation; see probes.hpp. Runs on the host after the backend synchronised the store.
+#include "fsi/probes.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "sph/dispatch.hpp"
+#include "sph/vec.hpp"
+
+namespace turbid::fsi {
+namespace {
+
+int material_index(const Scene& scene, const std::string& name) {
+  for (std::size_t m = 0; m < scene.materials.size(); ++m)
+    if (scene.materials[m].name == name) return int(m);
+  return -1;
+}
+
+template <int D>
+double evaluate(const Scene& scene, const ProbeSpec& probe, const sph::ParticleStore& s, const sph::FieldIds& ids,
+                const sph::PhysicsParams& params) {
+  using sph::Real;
+  using V = sph::Vec<D>;
+  const std::size_t n = s.size();
+  const V* x = s.data<V>(ids.position);
+  const V* v = s.data<V>(ids.velocity);
+  const Real* rho = s.data<Real>(ids.density);
+  const Real* p = s.data<Real>(ids.pressure);
+  const Real* m = s.data<Real>(ids.mass);
+  const std::uint8_t* mat = s.data<std::uint8_t>(ids.material);
+  const std::uint8_t* kind = s.data<std::uint8_t>(ids.kind);
+  auto fluid = [&](std::size_t i) { return kind[i] == std::uint8_t(sph::Kind::fluid); };
+
+  switch (probe.type) {
+    case ProbeSpec::Type::front_position: {
+      const int want = probe.material.empty() ? -1 : material_index(scene, probe.material);
+      double best = -std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i < n; ++i)
+        if (fluid(i) && (want < 0 || mat[i] == want)) best = std::max(best, double(x[i][probe.axis]));
+      return std::isfinite(best) ? best : std::nan("");
+    }
+    case ProbeSpec::Type::pressure: {
+      // Shepard interpolation of fluid pressure: sum p_j W V_j / sum W V_j.
+      double num = 0, den = 0;
+      const double h = params.smoothing_length;
+      V at;
+      for (int k = 0; k < D; ++k) at[k] = Real(probe.point[k]);
+      sph::dispatch_kernel<D>(params, [&](auto kernel_tag, auto) {
+        using K = typename decltype(kernel_tag)::type;
+        for (std::size_t i = 0; i < n; ++i) {
+          if (!fluid(i)) continue;
+          const double r = std::sqrt(double(sph::norm2(x[i] - at)));
+          if (r >= 2 * h) continue;
+          const double w = K::w(Real(r), Real(h)) * double(m[i]) / double(rho[i]);
+          num += w * p[i];
+          den += w;
+        }
+      });
+      return den > 0 ? num / den : std::nan("");
+    }
+    case ProbeSpec::Type::max_speed: {
+      double v2 = 0;
+      for (std::size_t i = 0; i < n; ++i)
+        if (fluid(i)) v2 = std::max(v2, double(sph::norm2(v[i])));
+      return std::sqrt(v2);
+    }
+    case ProbeSpec::Type::kinetic_energy: {
+      double e = 0;
+      for (std::size_t i = 0; i < n; ++i)
+        if (fluid(i)) e += 0.5 * double(m[i]) * double(sph::norm2(v[i]));
+      return e;
+    }
+    case ProbeSpec::Type::fluid_particles: {
+      std::size_t c = 0;
+      for (std::size_t i = 0; i < n; ++i) c += fluid(i) ? 1 : 0;
+      return double(c);
+    }
+  }
+  return std::nan("");
+}
+
+}  // namespace
+
+const char* probe_unit(ProbeSpec::Type t) {
+  switch (t) {
+    case ProbeSpec::Type::front_position: return "m";
+    case ProbeSpec::Type::pressure: return "Pa";
+    case ProbeSpec::Type::max_speed: return "m/s";
+    case ProbeSpec::Type::kinetic_energy: return "J";
+    case ProbeSpec::Type::fluid_particles: return "1";
+  }
+  return "";
+}
+
+std::vector<double> evaluate_probes(const Scene& scene, const sph::ParticleStore& store, const sph::FieldIds& ids,
+                                    const sph::PhysicsParams& params) {
+  std::vector<double> out;
+  out.reserve(scene.probes.size());
+  for (const auto& probe : scene.probes)
+    out.push_back(scene.dimensions == 2 ? evaluate<2>(scene, probe, store, ids, params)
+                                        : evaluate<3>(scene, probe, store, ids, params));
+  return out;
+}
+
+}  // namespace turbid::fsi

@@ -1,0 +1,106 @@
+// The Simulation: builds the particle world from a Scene, composes the fluid solver the scene
+// needs, runs the time loop and hands results to observers (writers registered by tools/).
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fsi/scene.hpp"
+#include "sph/backend.hpp"
+#include "sph/fields.hpp"
+#include "sph/particle_store.hpp"
+#include "sph/solver.hpp"
+
+namespace turbid::fsi {
+
+struct RunOptions {
+  std::string backend = "auto";  // auto | cpu | cuda
+  int threads = 0;               // CPU threads; 0 = OpenMP default
+};
+
+// Counts and derived values a user sees in `turbid check` and run.json.
+struct WorldSummary {
+  std::size_t fluid_particles = 0;
+  std::size_t wall_particles = 0;
+  std::vector<std::size_t> particles_per_material;
+  double smoothing_length = 0;     // [m]
+  std::vector<double> sound_speed; // per material [m/s]
+  std::size_t bytes_per_particle = 0;
+  sph::Domain domain;
+};
+
+class Simulation;
+
+// Receives the run's events. Called on the host with the store synchronised.
+class Observer {
+ public:
+  virtual ~Observer() = default;
+  virtual void on_output(Simulation&) {}      // at t = 0 and every output interval
+  virtual void on_checkpoint(Simulation&) {}  // every checkpoint interval
+  virtual void on_progress(const Simulation&) {}  // about twice a second of wall time
+  virtual void on_finish(Simulation&) {}
+};
+
+// Resolves scene defaults (automatic sound speed, wall layers) and converts to engine parameters.
+sph::PhysicsParams physics_params(const Scene& scene);
+int wall_layers(const Scene& scene, const WallSpec& wall);
+
+class Simulation {
+ public:
+  // Builds particles; throws std::invalid_argument with a readable message for impossible geometry.
+  Simulation(Scene scene, const RunOptions& options);
+
+  const Scene& scene() const { return scene_; }
+  const WorldSummary& summary() const { return summary_; }
+  sph::ParticleStore& store() { return store_; }
+  const sph::ParticleStore& store() const { return store_; }
+  const sph::FieldIds& fields() const { return ids_; }
+  const sph::PhysicsParams& params() const { return params_; }
+  sph::Backend& backend() { return solver_->backend(); }
+  std::string backend_name() const { return backend_name_; }
+  int threads() const { return threads_; }
+
+  double time() const { return solver_->time(); }
+  double end_time() const { return scene_.end_time; }
+  std::uint64_t steps() const { return solver_->steps(); }
+  std::uint64_t removed() const { return solver_->removed(); }
+  double last_time_step() const { return solver_->last_time_step(); }
+  double wall_seconds() const { return wall_seconds_; }
+  double particle_steps_per_second() const;
+
+  // Output bookkeeping, saved in checkpoints so a resumed run writes the same frames.
+  std::uint64_t output_index() const { return output_index_; }
+  std::uint64_t checkpoint_index() const { return checkpoint_index_; }
+  std::uint64_t particle_steps() const { return particle_steps_; }
+
+  // Fresh start: forces at t = 0. Or continue after the store was filled from a checkpoint.
+  void start();
+  void resume(double time, std::uint64_t steps, std::uint64_t removed, std::uint64_t output_index,
+              std::uint64_t checkpoint_index, std::uint64_t particle_steps);
+
+  // Runs to the end time; throws sph::BlowUp (after telling no observer) on a numerical failure.
+  void run(Observer& observer);
+  void step();
+
+  std::vector<double> probe_values();  // evaluated now (synchronises the store)
+  void sync_to_host() { solver_->backend().sync_to_host(); }
+
+ private:
+  void build_particles();
+
+  Scene scene_;
+  sph::PhysicsParams params_;
+  sph::ParticleStore store_;
+  sph::FieldIds ids_;
+  WorldSummary summary_;
+  std::unique_ptr<sph::Solver> solver_;
+  std::string backend_name_;
+  int threads_ = 1;
+  double wall_seconds_ = 0;
+  std::uint64_t output_index_ = 0;
+  std::uint64_t checkpoint_index_ = 0;
+  std::uint64_t particle_steps_ = 0;
+};
+
+}  // namespace turbid::fsi

@@ -1,0 +1,62 @@
+// What a backend supplies to the time loop: neighbour search (sort by cell), the physics passes run
+// over all particles, integration kernels and reductions. The physics itself lives in the shared
+// headers (passes.hpp, pair_physics.hpp); a backend only decides where and how loops run.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "sph/fields.hpp"
+#include "sph/particle_store.hpp"
+#include "sph/physics_params.hpp"
+
+namespace turbid::sph {
+
+// Particles outside this box are removed at the next neighbour update.
+struct Domain {
+  double min[3] = {0, 0, 0};
+  double max[3] = {0, 0, 0};
+};
+
+struct StepStats {
+  double max_speed = 0;         // largest fluid speed [m/s]
+  double max_acceleration = 0;  // largest fluid acceleration [m/s^2]
+};
+
+struct HealthIssue {
+  std::size_t index = 0;  // position in the store
+  std::uint32_t id = 0;   // particle id (stable across sorts)
+  std::string field;
+  double value = 0;
+};
+
+class Backend {
+ public:
+  virtual ~Backend() = default;
+  virtual std::string name() const = 0;
+  virtual int threads() const = 0;
+  virtual void bind(ParticleStore& store, const FieldIds& ids, const PhysicsParams& params, const Domain& domain) = 0;
+  // Sorts particles by cell and drops those outside the domain (or with non-finite position);
+  // returns how many were dropped.
+  virtual std::size_t update_neighbours() = 0;
+  virtual void compute_density_rate() = 0;  // density gradient if needed, continuity with diffusion
+  virtual void compute_forces() = 0;        // pressure from density, momentum
+  virtual void kick(double half_dt) = 0;    // v += half_dt a (fluid)
+  virtual void drift(double dt) = 0;        // x += dt v (fluid); rho += dt drho/dt (all)
+  virtual StepStats stats() = 0;
+  // First particle with a non-finite value or a density ratio |rho/rho0 - 1| above the limit.
+  virtual std::optional<HealthIssue> check_health(double density_ratio_limit) = 0;
+  virtual void sync_to_host() = 0;    // make the store current (no-op on the CPU)
+  virtual void sync_from_host() = 0;  // the store was edited on the host (resume)
+  virtual std::size_t pair_count() = 0;  // neighbour pairs within the support in the last force pass
+};
+
+std::unique_ptr<Backend> make_cpu_backend(int threads);
+bool cuda_backend_compiled();
+// Number of CUDA devices usable now (0 without a driver/GPU or in a CPU-only build), with a reason.
+int cuda_device_count(std::string* reason);
+std::unique_ptr<Backend> make_cuda_backend();  // throws std::runtime_error if unavailable
+
+}  // namespace turbid::sph

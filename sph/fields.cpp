@@ -1,0 +1,30 @@
+// Registration of the engine's particle fields; see fields.hpp.
+#include "sph/fields.hpp"
+
+namespace turbid::sph {
+
+FieldIds register_fields(ParticleStore& s, const PhysicsParams& p) {
+  const int d = p.dimensions;
+  // 2D runs are per metre of depth: mass is then kg/m and volumes m^2.
+  const char* mass_unit = d == 2 ? "kg/m" : "kg";
+  FieldIds f;
+  //                   name                unit          type              comp vtk    ckpt   sorted carry
+  f.position = s.add_field({"position", "m", ScalarType::f32, d, true, true, true, Carry::recompute});
+  f.velocity = s.add_field({"velocity", "m/s", ScalarType::f32, d, true, true, true, Carry::copy});
+  // Accelerations are recomputed right after every sort, but the first half-kick of a step uses
+  // the previous step's values, so they are checkpointed (bit-identical resume).
+  f.acceleration = s.add_field({"acceleration", "m/s^2", ScalarType::f32, d, false, true, false, Carry::copy});
+  f.density = s.add_field({"density", "kg/m^3", ScalarType::f32, 1, true, true, true, Carry::copy});
+  f.density_rate = s.add_field({"density_rate", "kg/m^3/s", ScalarType::f32, 1, false, false, false, Carry::recompute});
+  f.pressure = s.add_field({"pressure", "Pa", ScalarType::f32, 1, true, false, false, Carry::recompute});
+  f.mass = s.add_field({"mass", mass_unit, ScalarType::f32, 1, false, true, true, Carry::divide});
+  f.smoothing_length = s.add_field({"smoothing_length", "m", ScalarType::f32, 1, false, true, true, Carry::recompute});
+  f.material = s.add_field({"material", "", ScalarType::u8, 1, true, true, true, Carry::recompute});
+  f.kind = s.add_field({"kind", "", ScalarType::u8, 1, true, true, true, Carry::copy});
+  f.id = s.add_field({"id", "", ScalarType::u32, 1, true, true, true, Carry::recompute});
+  if (p.diffusion == Diffusion::antuono)
+    f.density_gradient = s.add_field({"density_gradient", "kg/m^4", ScalarType::f32, d, false, false, false, Carry::recompute});
+  return f;
+}
+
+}  // namespace turbid::sph

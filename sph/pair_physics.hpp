@@ -1,0 +1,62 @@
+// Per-pair terms of the weakly compressible δ-SPH equations, shared by all backends.
+// Notation (physics.md C): r_ij = x_i - x_j, grad_i W_ij = F_ij r_ij with F = (1/r) dW/dr < 0,
+// V_j = m_j / rho_j, v_ij = v_i - v_j.
+#pragma once
+#include <cmath>
+
+#include "sph/config.hpp"
+#include "sph/vec.hpp"
+
+namespace turbid::sph::pair {
+
+// Continuity in the volume form suited to several materials (Colagrossi & Landrini 2003, C10):
+// D rho_i / Dt += rho_i V_j v_ij . grad_i W_ij
+TURBID_HD inline Real continuity(Real rho_i, Real vol_j, Real vij_dot_rij, Real F) {
+  return rho_i * vol_j * vij_dot_rij * F;
+}
+
+// Molteni & Colagrossi (2009) diffusion, psi_ij = 2 (rho_j - rho_i) r_ji / r^2 (C3, first term):
+// delta h c0 psi . grad_i W V_j = delta h c0 * 2 (rho_i - rho_j) F V_j.
+TURBID_HD inline Real diffusion_molteni(Real delta_h_c0, Real rho_i, Real rho_j, Real vol_j, Real F) {
+  return delta_h_c0 * Real(2) * (rho_i - rho_j) * F * vol_j;
+}
+
+// Antuono et al. (2010) δ-SPH with renormalised density gradients (C3):
+// psi . grad_i W = 2 (rho_i - rho_j) F - F (grad_rho_i + grad_rho_j) . r_ij
+template <int D>
+TURBID_HD inline Real diffusion_antuono(Real delta_h_c0, Real rho_i, Real rho_j, const Vec<D>& grad_i,
+                                        const Vec<D>& grad_j, const Vec<D>& rij, Real vol_j, Real F) {
+  return delta_h_c0 * F * vol_j * (Real(2) * (rho_i - rho_j) - dot(grad_i + grad_j, rij));
+}
+
+// Fourtakas et al. (2019) diffusion of the dynamic density only (C4): the hydrostatic density
+// difference rho^H_ij = rho0 [(1 + rho0 g (z_i - z_j) / B)^(1/gamma) - 1] is removed first.
+// Sign: diffusive when rho_j - rho_i exceeds the hydrostatic difference.
+TURBID_HD inline Real diffusion_fourtakas(Real delta_2h_c0, Real rho_i, Real rho_j, Real rho_h_ij, Real r2,
+                                          Real eta2, Real vol_j, Real F) {
+  return -delta_2h_c0 * ((rho_j - rho_i) - rho_h_ij) * F * r2 / (r2 + eta2) * vol_j;
+}
+
+// Pressure acceleration, symmetric form -m_j (p_i + p_j)/(rho_i rho_j) grad_i W (C10, DualSPHysics):
+// returns the scalar s so that a_i += s r_ij. Antisymmetric in i, j: momentum is conserved.
+TURBID_HD inline Real pressure(Real m_j, Real p_i, Real p_j, Real rho_i, Real rho_j, Real F) {
+  return -m_j * (p_i + p_j) / (rho_i * rho_j) * F;
+}
+
+// Monaghan (1992) artificial viscosity, active for approaching pairs: returns s with a_i += s r_ij.
+TURBID_HD inline Real artificial_viscosity(Real alpha, Real h, Real c_mean, Real rho_mean, Real m_j,
+                                           Real vij_dot_rij, Real r2, Real eta2, Real F) {
+  if (vij_dot_rij >= Real(0)) return Real(0);
+  const Real mu = h * vij_dot_rij / (r2 + eta2);
+  const Real pi_ij = -alpha * c_mean * mu / rho_mean;
+  return -m_j * pi_ij * F;
+}
+
+// Morris, Fox & Zhu (1997) laminar viscosity: a_i += s v_ij with
+// s = m_j (mu_i + mu_j) r_ij . grad_i W / (rho_i rho_j (r^2 + eta^2)).
+TURBID_HD inline Real laminar_viscosity(Real m_j, Real mu_i, Real mu_j, Real rho_i, Real rho_j, Real r2, Real eta2,
+                                        Real F) {
+  return m_j * (mu_i + mu_j) * F * r2 / (rho_i * rho_j * (r2 + eta2));
+}
+
+}  // namespace turbid::sph::pair

@@ -1,0 +1,307 @@
+// Tests of the YAML scene reader (tools/scene_reader): every bad scene in tests/data/bad_scenes is
+// rejected with "FILE:LINE:COL: error: ..." pointing at the offending key or value, and the good
+// scenes in tests/data/good_scenes parse to the values written in them (or the documented defaults).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <filesystem>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "tools/scene_reader.hpp"
+
+namespace {
+
+using turbid::tools::read_scene_file;
+using turbid::tools::read_scene_string;
+using turbid::tools::SceneError;
+
+const std::string kData = TURBID_TEST_DATA_DIR;
+
+// The message of the SceneError that reading `path` throws; fails the test when nothing is thrown.
+std::string error_of_file(const std::string& path) {
+  try {
+    read_scene_file(path);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no SceneError for " << path;
+  return {};
+}
+
+std::string error_of_string(const std::string& yaml, const std::string& name = "inline.yaml") {
+  try {
+    read_scene_string(yaml, name);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no SceneError for:\n" << yaml;
+  return {};
+}
+
+struct BadScene {
+  const char* file;    // in tests/data/bad_scenes
+  int line;            // 1-based, as an editor shows it
+  int column;          // 1-based
+  const char* phrase;  // must appear in the message
+  const char* checks;  // what the case is about
+};
+
+// Lines and columns were counted by hand in each file: they point at the offending value, the
+// offending key, or (for a missing key) the map that lacks it.
+const BadScene kBadScenes[] = {
+    {"negative_spacing.yaml", 6, 21, "'particle_spacing' must be a positive number [m], got -0.01",
+     "a number out of range names the key, the requirement with its unit and the value"},
+    {"typo_key.yaml", 5, 3, "unknown key 'partical_spacing' in 'resolution'; did you mean 'particle_spacing'?",
+     "a misspelt key is reported at the key with a suggestion, not as a missing key"},
+    {"missing_name.yaml", 2, 1, "missing required key 'name' in the scene",
+     "a missing top-level key is located at the top-level map"},
+    {"missing_spacing.yaml", 4, 13, "missing required key 'particle_spacing' in 'resolution'",
+     "a missing nested key is located at the map that lacks it"},
+    {"string_for_number.yaml", 8, 14, "'density' must be a positive number [kg/m^3], got 'heavy'",
+     "a string where a number is expected"},
+    {"map_for_list.yaml", 9, 3, "'fluids' must be a list, got a map", "a map where a list is expected"},
+    {"gravity_components.yaml", 6, 10, "'gravity' must be a list of 2 numbers", "a vector with the wrong count"},
+    {"bad_dimensions.yaml", 3, 13, "'dimensions' must be 2 or 3, got 4", "dimensions other than 2 or 3"},
+    {"unknown_fluid_material.yaml", 9, 16, "unknown material 'watr' in item 1 of 'fluids'; did you mean 'water'?",
+     "a fluid block naming an undefined material"},
+    {"unknown_probe_material.yaml", 13, 15, "unknown material 'sand' in probe 'front'",
+     "a probe naming an undefined material"},
+    {"duplicate_probe.yaml", 13, 12, "duplicate probe name 'vmax' (first used at line 11)",
+     "two probes with one name; the second is reported and the first's line named"},
+    {"probe_name_comma.yaml", 11, 12, "cannot be a CSV column header", "a probe name with a comma"},
+    {"empty_fluid.yaml", 10, 10, "empty fluid region", "a fluid box of zero height"},
+    {"thin_fluid.yaml", 11, 7, "fewer than one particle per axis", "a fluid box thinner than the spacing"},
+    {"fluid_in_solid.yaml", 12, 28, "overlaps the 'solid_box' of item 2 of 'walls' (line 10)",
+     "a fluid box overlapping an obstacle"},
+    {"fluid_outside_container.yaml", 12, 28, "pokes out of the container 'box' of item 1 of 'walls' (line 9) through its +x face",
+     "a fluid box leaving the tank through a closed face"},
+    {"polyline_3d.yaml", 9, 5, "'polyline' walls exist only in 2D scenes", "a polyline wall in a 3D scene"},
+    {"inverted_box.yaml", 9, 16, "'solid_box' needs min < max on every axis, got min x = 2 and max x = 1",
+     "a box with min > max"},
+    {"unsupported_model.yaml", 7, 16, "material model 'bingham' is not supported yet",
+     "a planned rheology model is refused clearly (before its extra keys are called unknown)"},
+    {"ratio_range.yaml", 4, 55, "'smoothing_ratio' must be a number in (0.5, 3], got 3.5",
+     "a ratio outside its interval"},
+    {"open_z_in_2d.yaml", 10, 16, "got '+z' (a 2D scene has no z faces)", "a z face in a 2D container"},
+    {"duplicate_key.yaml", 7, 3, "duplicate key 'end' in 'time' (first given at line 6)",
+     "a key given twice (yaml-cpp would silently keep one)"},
+    {"no_materials.yaml", 6, 12, "'materials' must define at least one material", "an empty materials map"},
+    {"bad_component.yaml", 9, 38, "component y of 'min' must be a number [m], got 'zero'",
+     "a bad component is located at the component itself"},
+    {"kernel_typo.yaml", 7, 11, "got 'wendland'; did you mean 'wendland_c2'?",
+     "an enum value that is a prefix of an allowed value gets a suggestion"},
+    {"two_wall_shapes.yaml", 10, 5, "has both 'box' and 'solid_box'", "a wall item with two shapes"},
+    {"laminar_alpha.yaml", 7, 30, "'alpha' applies only to 'artificial' viscosity",
+     "an option that has no meaning for the chosen type"},
+    {"pressure_without_point.yaml", 11, 5, "missing required key 'point' in item 1 of 'probes'",
+     "a pressure probe without its point"},
+    {"axis_z_in_2d.yaml", 11, 47, "'axis' must be 'x' or 'y', got 'z'", "a z axis in a 2D scene"},
+    {"not_a_map.yaml", 2, 1, "the scene must be a map", "a top level that is a list"},
+    {"syntax_error.yaml", 7, 10, "invalid YAML: end of sequence flow not found",
+     "a yaml-cpp parser error converted to the same form"},
+    {"empty_value.yaml", 4, 1, "'resolution' must be a map with keys particle_spacing, smoothing_ratio, got an empty value",
+     "an empty value is located at its key (yaml-cpp marks it at the next line)"},
+    {"point_for_max_speed.yaml", 11, 35, "'point' does not apply to a 'max_speed' probe",
+     "a key that belongs to another probe type"},
+    {"structures.yaml", 10, 1, "'structures' are not supported by the scene reader yet",
+     "a planned section is refused clearly"},
+};
+
+class SceneReaderBadFile : public ::testing::TestWithParam<BadScene> {};
+
+// Each bad scene throws SceneError with exactly "PATH:LINE:COL: error: " in front and the key phrase.
+TEST_P(SceneReaderBadFile, ReportsLineColumnAndWhatWasExpected) {
+  const BadScene& c = GetParam();
+  SCOPED_TRACE(c.checks);
+  const std::string path = kData + "/bad_scenes/" + c.file;
+  const std::string message = error_of_file(path);
+  const std::string prefix = path + ":" + std::to_string(c.line) + ":" + std::to_string(c.column) + ": error: ";
+  EXPECT_EQ(message.rfind(prefix, 0), 0u) << "expected prefix: " << prefix << "\n  got: " << message;
+  EXPECT_NE(message.find(c.phrase), std::string::npos) << "expected phrase: " << c.phrase << "\n  got: " << message;
+}
+
+INSTANTIATE_TEST_SUITE_P(SceneFiles, SceneReaderBadFile, ::testing::ValuesIn(kBadScenes),
+                         [](const ::testing::TestParamInfo<BadScene>& info) {
+                           std::string name = std::filesystem::path(info.param.file).stem().string();
+                           std::replace_if(name.begin(), name.end(), [](char ch) { return !std::isalnum(ch); }, '_');
+                           return name;
+                         });
+
+// Every file in bad_scenes/ has a row above, so no bad scene sits there untested.
+TEST(SceneReader, EveryBadSceneFileIsInTheTable) {
+  std::set<std::string> listed;
+  for (const BadScene& c : kBadScenes) listed.insert(c.file);
+  EXPECT_GE(listed.size(), 14u);
+  for (const auto& entry : std::filesystem::directory_iterator(kData + "/bad_scenes"))
+    EXPECT_TRUE(listed.count(entry.path().filename().string())) << entry.path() << " has no row in kBadScenes";
+}
+
+// A misspelt key in a scene held in memory: the suggestion, the file name given for messages, and
+// the column of the key.
+TEST(SceneReader, TypoSuggestsTheIntendedKey) {
+  const std::string message = error_of_string(
+      "name: t\n"
+      "dimensions: 2\n"
+      "resolution: {partical_spacing: 0.01}\n",
+      "my_scene.yaml");
+  EXPECT_EQ(message, "my_scene.yaml:3:14: error: unknown key 'partical_spacing' in 'resolution'; "
+                     "did you mean 'particle_spacing'?");
+}
+
+// A key that is a prefix of an allowed key is suggested even beyond two edits; a key close to
+// nothing lists the allowed keys instead of guessing.
+TEST(SceneReader, SuggestsPrefixesAndListsKeysWhenNothingIsClose) {
+  const std::string prefix = error_of_string("name: t\ndimensions: 2\nresolution: {particle_spacing: 0.01, smoothing: 1.2}\n");
+  EXPECT_NE(prefix.find("did you mean 'smoothing_ratio'?"), std::string::npos) << prefix;
+  const std::string far = error_of_string("name: t\ndimensions: 2\nresolution: {particle_spacing: 0.01, colour: red}\n");
+  EXPECT_EQ(far.find("did you mean"), std::string::npos) << far;
+  EXPECT_NE(far.find("(expected one of: particle_spacing, smoothing_ratio)"), std::string::npos) << far;
+}
+
+// A file that does not exist is a SceneError in the same form, naming the path.
+TEST(SceneReader, MissingFileIsASceneError) {
+  const std::string path = kData + "/no_such_scene.yaml";
+  const std::string message = error_of_file(path);
+  EXPECT_EQ(message.rfind(path + ":1:1: error: cannot open the scene file", 0), 0u) << message;
+}
+
+// A yaml-cpp ParserException becomes "FILE:LINE:COL: error: invalid YAML: ..." with 1-based positions
+// (yaml-cpp's Mark is 0-based): "a: b: c" is illegal at the second colon, line 2 column 5.
+TEST(SceneReader, YamlSyntaxErrorIsConverted) {
+  const std::string message = error_of_string("name: t\na: b: c\n", "syntax.yaml");
+  EXPECT_EQ(message.rfind("syntax.yaml:2:5: error: invalid YAML: ", 0), 0u) << message;
+}
+
+// An empty text and a text of two YAML documents are refused.
+TEST(SceneReader, EmptyOrMultiDocumentTextIsRefused) {
+  EXPECT_NE(error_of_string("# nothing\n").find("inline.yaml:1:1: error: the scene file is empty"), std::string::npos);
+  EXPECT_NE(error_of_string("name: a\n---\nname: b\n").find("inline.yaml:3:1: error: the scene file holds more than one"),
+            std::string::npos);
+}
+
+// The 2D good scene: every section given with non-default values, checked against the file.
+TEST(SceneReader, GoodDamBreak2dParsesToTheWrittenValues) {
+  const std::string path = kData + "/good_scenes/dam_break_2d.yaml";
+  const turbid::fsi::Scene s = read_scene_file(path);
+  using turbid::fsi::WallSpec;
+  using turbid::fsi::ProbeSpec;
+  EXPECT_EQ(s.name, "dam_break_2d");
+  EXPECT_EQ(s.source_file, path);
+  EXPECT_EQ(s.dimensions, 2);
+  EXPECT_DOUBLE_EQ(s.particle_spacing, 0.01);
+  EXPECT_DOUBLE_EQ(s.smoothing_ratio, 1.5);
+  EXPECT_DOUBLE_EQ(s.end_time, 1.5);
+  EXPECT_DOUBLE_EQ(s.numerics.cfl, 0.25);
+  EXPECT_DOUBLE_EQ(s.gravity[0], 0.0);
+  EXPECT_DOUBLE_EQ(s.gravity[1], -9.81);
+  EXPECT_DOUBLE_EQ(s.gravity[2], 0.0);
+  EXPECT_EQ(s.numerics.kernel, turbid::sph::KernelKind::cubic_spline);
+  EXPECT_EQ(s.numerics.diffusion, turbid::fsi::DiffusionKind::molteni);
+  EXPECT_DOUBLE_EQ(s.numerics.diffusion_delta, 0.05);
+  EXPECT_EQ(s.numerics.viscosity, turbid::fsi::ViscosityKind::artificial);
+  EXPECT_DOUBLE_EQ(s.numerics.artificial_viscosity, 0.02);
+  EXPECT_DOUBLE_EQ(s.numerics.min_time_step, 1.0e-8);
+
+  ASSERT_EQ(s.materials.size(), 2u);
+  EXPECT_EQ(s.materials[0].name, "water");
+  EXPECT_DOUBLE_EQ(s.materials[0].density, 1000.0);
+  EXPECT_DOUBLE_EQ(s.materials[0].viscosity, 1.0e-3);
+  EXPECT_DOUBLE_EQ(s.materials[0].sound_speed, 30.0);
+  EXPECT_DOUBLE_EQ(s.materials[0].gamma, 7.0);
+  EXPECT_DOUBLE_EQ(s.materials[0].background_pressure, 10.0);
+  EXPECT_EQ(s.materials[0].where.line, 13);
+  EXPECT_EQ(s.materials[0].where.column, 3);
+  EXPECT_EQ(s.materials[1].name, "oil");
+  EXPECT_DOUBLE_EQ(s.materials[1].density, 900.0);
+  EXPECT_DOUBLE_EQ(s.materials[1].sound_speed, 0.0);  // omitted: automatic
+
+  ASSERT_EQ(s.walls.size(), 3u);
+  EXPECT_EQ(s.walls[0].kind, WallSpec::Kind::container);
+  EXPECT_DOUBLE_EQ(s.walls[0].box.max[0], 3.22);
+  EXPECT_DOUBLE_EQ(s.walls[0].box.max[1], 1.8);
+  EXPECT_EQ(s.walls[0].open, (std::array<bool, 6>{false, false, false, true, false, false}));
+  EXPECT_EQ(s.walls[0].layers, 3);
+  EXPECT_EQ(s.walls[0].where.line, 17);
+  EXPECT_EQ(s.walls[1].kind, WallSpec::Kind::solid_box);
+  EXPECT_DOUBLE_EQ(s.walls[1].box.min[0], 2.0);
+  EXPECT_EQ(s.walls[1].layers, 0);  // omitted: automatic
+  EXPECT_EQ(s.walls[2].kind, WallSpec::Kind::polyline);
+  ASSERT_EQ(s.walls[2].points.size(), 3u);
+  EXPECT_DOUBLE_EQ(s.walls[2].points[1][0], 3.0);
+  EXPECT_DOUBLE_EQ(s.walls[2].points[1][1], 0.5);
+  EXPECT_DOUBLE_EQ(s.walls[2].points[1][2], 0.0);
+  EXPECT_FALSE(s.walls[2].closed);
+  EXPECT_EQ(s.walls[2].side, +1);  // left
+
+  ASSERT_EQ(s.fluids.size(), 2u);
+  EXPECT_EQ(s.fluids[0].material, "water");
+  EXPECT_DOUBLE_EQ(s.fluids[0].box.max[0], 1.2);
+  EXPECT_DOUBLE_EQ(s.fluids[0].box.max[1], 0.6);
+  EXPECT_EQ(s.fluids[0].where.file, path);
+  EXPECT_EQ(s.fluids[0].where.line, 23);
+  EXPECT_EQ(s.fluids[0].where.column, 5);
+  EXPECT_EQ(s.fluids[1].material, "oil");
+  EXPECT_DOUBLE_EQ(s.fluids[1].box.min[0], 1.2);
+
+  ASSERT_EQ(s.probes.size(), 5u);
+  EXPECT_EQ(s.probes[0].type, ProbeSpec::Type::front_position);
+  EXPECT_EQ(s.probes[0].material, "water");
+  EXPECT_EQ(s.probes[0].axis, 0);
+  EXPECT_EQ(s.probes[1].type, ProbeSpec::Type::pressure);
+  EXPECT_DOUBLE_EQ(s.probes[1].point[0], 3.2);
+  EXPECT_DOUBLE_EQ(s.probes[1].point[1], 0.05);
+  EXPECT_EQ(s.probes[2].type, ProbeSpec::Type::max_speed);
+  EXPECT_EQ(s.probes[3].type, ProbeSpec::Type::kinetic_energy);
+  EXPECT_EQ(s.probes[4].type, ProbeSpec::Type::fluid_particles);
+  EXPECT_EQ(s.probes[4].name, "n");
+  EXPECT_EQ(s.probes[4].where.line, 31);
+
+  EXPECT_DOUBLE_EQ(s.output.every, 0.02);
+  EXPECT_FALSE(s.output.vtk);
+  EXPECT_DOUBLE_EQ(s.output.checkpoint_every, 0.5);
+  ASSERT_TRUE(s.domain.has_value());
+  EXPECT_DOUBLE_EQ(s.domain->min[0], -0.5);
+  EXPECT_DOUBLE_EQ(s.domain->max[1], 3.0);
+}
+
+// The 3D good scene gives only a few keys, so the defaults of the schema show: smoothing ratio 1.3,
+// gravity -9.81 on z, material viscosity 1e-3 and gamma 7, Scene's numerics defaults.
+TEST(SceneReader, GoodTank3dUsesTheDefaults) {
+  const turbid::fsi::Scene s = read_scene_file(kData + "/good_scenes/tank_3d.yaml");
+  EXPECT_EQ(s.name, "tank_3d");
+  EXPECT_EQ(s.dimensions, 3);
+  EXPECT_DOUBLE_EQ(s.particle_spacing, 0.02);
+  EXPECT_DOUBLE_EQ(s.smoothing_ratio, 1.3);
+  EXPECT_DOUBLE_EQ(s.end_time, 0.5);
+  EXPECT_DOUBLE_EQ(s.gravity[0], 0.0);
+  EXPECT_DOUBLE_EQ(s.gravity[1], 0.0);
+  EXPECT_DOUBLE_EQ(s.gravity[2], -9.81);
+  EXPECT_DOUBLE_EQ(s.numerics.cfl, 0.2);
+  EXPECT_EQ(s.numerics.kernel, turbid::sph::KernelKind::wendland_c2);
+  EXPECT_EQ(s.numerics.diffusion, turbid::fsi::DiffusionKind::fourtakas);
+  ASSERT_EQ(s.materials.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.materials[0].density, 1025.0);
+  EXPECT_DOUBLE_EQ(s.materials[0].viscosity, 1.0e-3);
+  EXPECT_DOUBLE_EQ(s.materials[0].gamma, 7.0);
+  EXPECT_EQ(s.materials[0].model, "newtonian");
+  ASSERT_EQ(s.fluids.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.fluids[0].box.max[1], 1.0);
+  EXPECT_DOUBLE_EQ(s.fluids[0].box.max[2], 0.3);
+  ASSERT_EQ(s.walls.size(), 2u);
+  EXPECT_EQ(s.walls[1].kind, turbid::fsi::WallSpec::Kind::solid_box);
+  EXPECT_EQ(s.walls[1].layers, 2);
+  EXPECT_DOUBLE_EQ(s.walls[1].box.max[2], 0.2);
+  ASSERT_EQ(s.probes.size(), 2u);
+  EXPECT_EQ(s.probes[0].material, "");  // any fluid
+  EXPECT_EQ(s.probes[0].axis, 0);       // default x
+  EXPECT_DOUBLE_EQ(s.probes[1].point[2], 0.05);
+  EXPECT_TRUE(s.output.vtk);
+  EXPECT_DOUBLE_EQ(s.output.every, 0.0);
+  EXPECT_FALSE(s.domain.has_value());
+}
+
+}  // namespace

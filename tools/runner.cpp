@@ -1,0 +1,249 @@
+// `turbid run` behind the command line; see runner.hpp.
+#include "tools/runner.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "fsi/simulation.hpp"
+#include "tools/checkpoint.hpp"
+#include "tools/csv_writer.hpp"
+#include "tools/run_report.hpp"
+#include "tools/scene_reader.hpp"
+#include "tools/vtk_writer.hpp"
+
+namespace turbid::tools {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string format_duration(double s) {
+  if (!std::isfinite(s) || s < 0) return "--:--";
+  const long t = long(s + 0.5);
+  char buf[32];
+  if (t >= 3600) std::snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", t / 3600, (t / 60) % 60, t % 60);
+  else std::snprintf(buf, sizeof buf, "%02ld:%02ld", t / 60, t % 60);
+  return buf;
+}
+
+double fluid_mass(const fsi::Simulation& sim) {
+  const auto& s = sim.store();
+  const auto* m = s.data<float>(sim.fields().mass);
+  const auto* kind = s.data<std::uint8_t>(sim.fields().kind);
+  double total = 0;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (kind[i] == 0) total += m[i];
+  return total;
+}
+
+class Writers final : public fsi::Observer {
+ public:
+  Writers(const fs::path& out, const fsi::Scene& scene, std::optional<double> resume_time, bool progress)
+      : out_(out), progress_(progress), tty_(isatty(fileno(stderr)) != 0) {
+    std::vector<std::string> names;
+    for (const auto& p : scene.probes) names.push_back(p.name);
+    probes_.emplace(out / "probes.csv", names, resume_time);
+    if (scene.output.vtk) {
+      vtk_.emplace(out, scene.dimensions);
+      if (resume_time) vtk_->resume_after(*resume_time);
+    }
+  }
+
+  void on_output(fsi::Simulation& sim) override {
+    const auto values = sim.probe_values();
+    probes_->append(sim.time(), values);
+    if (vtk_) vtk_->write(sim.store(), sim.time());
+  }
+
+  void on_checkpoint(fsi::Simulation& sim) override { save_checkpoint(sim); }
+
+  void on_progress(const fsi::Simulation& sim) override {
+    if (!progress_) return;
+    const double rate = sim.particle_steps_per_second();
+    const double frac = sim.time() / sim.end_time();
+    const double elapsed = sim.wall_seconds() - wall_at_start_;
+    const double done = sim.time() - time_at_start_;
+    const double eta = done > 0 ? elapsed * (sim.end_time() - sim.time()) / done : NAN;
+    char line[256];
+    std::snprintf(line, sizeof line, "t = %.4g / %.4g s (%3.0f%%) | step %llu | dt %.2e s | %.3g particle-steps/s | ETA %s",
+                  sim.time(), sim.end_time(), 100 * frac, static_cast<unsigned long long>(sim.steps()),
+                  sim.last_time_step(), rate, format_duration(eta).c_str());
+    if (tty_) {
+      std::fprintf(stderr, "\r%-110s", line);
+    } else if (sim.wall_seconds() - last_plain_ >= 10.0 || sim.time() >= sim.end_time()) {
+      std::fprintf(stderr, "%s\n", line);
+      last_plain_ = sim.wall_seconds();
+    }
+    std::fflush(stderr);
+  }
+
+  void on_finish(fsi::Simulation&) override {
+    if (progress_ && tty_) std::fprintf(stderr, "\n");
+  }
+
+  void save_checkpoint(fsi::Simulation& sim) {
+    nlohmann::json state;
+    state["time"] = sim.time();
+    state["steps"] = sim.steps();
+    state["removed"] = sim.removed();
+    state["output_index"] = sim.output_index();
+    state["checkpoint_index"] = sim.checkpoint_index();
+    state["particle_steps"] = sim.particle_steps();
+    state["wall_seconds"] = sim.wall_seconds();
+    state["particle_spacing"] = sim.scene().particle_spacing;
+    state["end_time"] = sim.scene().end_time;
+    write_checkpoint(out_ / "checkpoint", sim.store(), state);
+  }
+
+  void start_clock(const fsi::Simulation& sim) {
+    wall_at_start_ = sim.wall_seconds();
+    time_at_start_ = sim.time();
+  }
+
+ private:
+  fs::path out_;
+  bool progress_;
+  bool tty_;
+  double last_plain_ = 0;
+  double wall_at_start_ = 0, time_at_start_ = 0;
+  std::optional<CsvSeriesWriter> probes_;
+  std::optional<VtkSeriesWriter> vtk_;
+};
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+}  // namespace
+
+void apply_overrides(fsi::Scene& scene, const RunRequest& r) {
+  if (r.spacing) {
+    if (!(*r.spacing > 0)) throw std::invalid_argument("--spacing must be a positive length [m]");
+    scene.particle_spacing = *r.spacing;
+  }
+  if (r.end_time) {
+    if (!(*r.end_time > 0)) throw std::invalid_argument("--end must be a positive time [s]");
+    scene.end_time = *r.end_time;
+  }
+  if (r.checkpoint_every) {
+    if (!(*r.checkpoint_every >= 0)) throw std::invalid_argument("--checkpoint-every must be >= 0 [s]");
+    scene.output.checkpoint_every = *r.checkpoint_every;
+  }
+}
+
+std::string describe_scene(const fsi::Scene& scene) {
+  fsi::RunOptions opts;
+  opts.backend = "cpu";
+  fsi::Simulation sim(scene, opts);
+  const auto& s = sim.summary();
+  std::ostringstream os;
+  const std::size_t total = s.fluid_particles + s.wall_particles;
+  os << "scene            " << scene.name << " (" << scene.dimensions << "D)\n";
+  os << "spacing          " << scene.particle_spacing << " m, h = " << s.smoothing_length << " m\n";
+  os << "particles        " << total << " (fluid " << s.fluid_particles << ", wall " << s.wall_particles << ")\n";
+  for (std::size_t m = 0; m < scene.materials.size(); ++m)
+    os << "  material " << scene.materials[m].name << ": " << s.particles_per_material[m]
+       << " particles, sound speed " << s.sound_speed[m] << " m/s\n";
+  os << "domain           [" << s.domain.min[0] << ", " << s.domain.max[0] << "] x [" << s.domain.min[1] << ", "
+     << s.domain.max[1] << "]";
+  if (scene.dimensions == 3) os << " x [" << s.domain.min[2] << ", " << s.domain.max[2] << "]";
+  os << " m\n";
+  const double mib = double(total) * double(s.bytes_per_particle) / (1024.0 * 1024.0);
+  os << "memory           " << s.bytes_per_particle << " bytes/particle, about " << mib << " MiB\n";
+  os << "end time         " << scene.end_time << " s, output every " << scene.output.every << " s\n";
+  return os.str();
+}
+
+nlohmann::json run_scene(const RunRequest& request) {
+  fsi::Scene scene;
+  nlohmann::json ck_state;
+  fs::path out = request.out;
+  std::optional<double> resume_time;
+  if (request.resume) {
+    const fs::path dir = *request.resume;
+    if (out.empty()) out = dir;
+    const fs::path saved_scene = dir / "scene.yaml";
+    if (!fs::exists(saved_scene))
+      throw std::runtime_error(saved_scene.string() + ": not found (is " + dir.string() + " a turbid run directory?)");
+    scene = read_scene_file(saved_scene.string());
+    ck_state = nlohmann::json::parse(read_text(dir / "checkpoint" / "checkpoint.json"))["state"];
+    scene.particle_spacing = ck_state.at("particle_spacing").get<double>();
+    scene.end_time = ck_state.at("end_time").get<double>();
+    resume_time = ck_state.at("time").get<double>();
+  } else {
+    scene = read_scene_file(request.scene_file.string());
+  }
+  apply_overrides(scene, request);
+  fs::create_directories(out);
+  if (!request.resume) {
+    // Keep the scene beside its results so that a run can be resumed and reproduced.
+    const std::string text = read_text(request.scene_file);
+    std::ofstream(out / "scene.yaml", std::ios::binary) << text;
+  } else if (fs::absolute(out) != fs::absolute(*request.resume)) {
+    fs::copy_file(*request.resume / "scene.yaml", out / "scene.yaml", fs::copy_options::overwrite_existing);
+  }
+
+  fsi::RunOptions opts;
+  opts.backend = request.backend;
+  opts.threads = request.threads;
+  fsi::Simulation sim(scene, opts);
+  const std::size_t initial_particles = sim.store().size();
+  const double mass_start = fluid_mass(sim);
+  Writers writers(out, sim.scene(), resume_time, request.progress);
+
+  if (request.resume) {
+    const auto state = read_checkpoint(*request.resume / "checkpoint", sim.store());
+    sim.resume(state.at("time").get<double>(), state.at("steps").get<std::uint64_t>(),
+               state.at("removed").get<std::uint64_t>(), state.at("output_index").get<std::uint64_t>(),
+               state.at("checkpoint_index").get<std::uint64_t>(), state.at("particle_steps").get<std::uint64_t>());
+  } else {
+    sim.start();
+  }
+  writers.start_clock(sim);
+
+  nlohmann::json report;
+  report["scene"] = scene.name;
+  report["dimensions"] = scene.dimensions;
+  report["particle_spacing"] = scene.particle_spacing;
+  report["smoothing_length"] = sim.summary().smoothing_length;
+  report["fluid_particles"] = sim.summary().fluid_particles;
+  report["wall_particles"] = sim.summary().wall_particles;
+  report["backend"] = sim.backend_name();
+  report["threads"] = sim.threads();
+  report["git_revision"] = TURBID_GIT_REVISION;
+  report["version"] = TURBID_VERSION;
+  report["units"] = {{"simulated_time", "s"}, {"wall_seconds", "s"}, {"particle_steps_per_second", "1/s"},
+                     {"fluid_mass", scene.dimensions == 2 ? "kg/m" : "kg"}};
+  std::string status = "completed";
+  try {
+    sim.run(writers);
+  } catch (const sph::BlowUp& e) {
+    status = "blow-up";
+    report["error"] = e.what();
+  }
+  sim.sync_to_host();
+  const double mass_end = fluid_mass(sim);
+  report["status"] = status;
+  report["particles"] = initial_particles;
+  report["particles_end"] = sim.store().size();
+  report["removed_particles"] = sim.removed();
+  report["steps"] = sim.steps();
+  report["simulated_time"] = sim.time();
+  report["wall_seconds"] = sim.wall_seconds();
+  report["particle_steps_per_second"] = sim.particle_steps_per_second();
+  report["fluid_mass_start"] = mass_start;
+  report["fluid_mass_end"] = mass_end;
+  report["fluid_mass_relative_change"] = (mass_end - mass_start) / mass_start;
+  write_run_json(out / "run.json", report);
+  return report;
+}
+
+}  // namespace turbid::tools

@@ -1,0 +1,726 @@
+// The YAML scene reader. It walks the yaml-cpp node tree by hand rather than with as<T>(), because
+// every value must be checked against the schema and every error must point at the line and column
+// of the offending key or value. Checks that relate several items (a fluid inside a container, an
+// unknown material) run while reading, after the items they refer to, so they can still point at
+// the YAML node. The first error stops the read: a scene either parses completely or not at all.
+#include "tools/scene_reader.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iomanip>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <string_view>
+#include <vector>
+
+namespace turbid::tools {
+namespace {
+
+using fsi::Vec3d;
+
+constexpr const char* kAxisName[3] = {"x", "y", "z"};
+constexpr const char* kFaceName[6] = {"-x", "+x", "-y", "+y", "-z", "+z"};
+
+std::string to_lower(std::string_view s) {
+  std::string out(s);
+  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+// Optimal string alignment distance (Levenshtein plus swaps of adjacent letters), so that each of
+// the common typos (a letter missing, extra, wrong or swapped) counts as one edit.
+int edit_distance(std::string_view a, std::string_view b) {
+  const std::size_t n = a.size(), m = b.size();
+  std::vector<std::vector<int>> d(n + 1, std::vector<int>(m + 1, 0));
+  for (std::size_t i = 0; i <= n; ++i) d[i][0] = static_cast<int>(i);
+  for (std::size_t j = 0; j <= m; ++j) d[0][j] = static_cast<int>(j);
+  for (std::size_t i = 1; i <= n; ++i) {
+    for (std::size_t j = 1; j <= m; ++j) {
+      const int cost = a[i - 1] == b[j - 1] ? 0 : 1;
+      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
+        d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+    }
+  }
+  return d[n][m];
+}
+
+// The allowed word that `word` was most likely meant to be: within two edits (ignoring case), or
+// one of the two a prefix of the other. Nothing when no guess is close enough to help; a guess
+// that replaces most of a very short word is not a guess but noise.
+std::optional<std::string> closest(std::string_view word, const std::vector<std::string>& allowed) {
+  const std::string w = to_lower(word);
+  std::optional<std::string> best;
+  int best_distance = 3;
+  for (const std::string& candidate : allowed) {
+    const std::string c = to_lower(candidate);
+    int d = edit_distance(w, c);
+    if (d > 2 || d >= static_cast<int>(w.size())) {
+      const bool prefix = std::min(w.size(), c.size()) >= 2 && (c.starts_with(w) || w.starts_with(c));
+      if (!prefix) continue;
+      d = 2;
+    }
+    if (d < best_distance) {
+      best_distance = d;
+      best = candidate;
+    }
+  }
+  return best;
+}
+
+std::string did_you_mean(std::string_view word, const std::vector<std::string>& allowed) {
+  const auto guess = closest(word, allowed);
+  return guess ? "; did you mean '" + *guess + "'?" : std::string();
+}
+
+std::string join(const std::vector<std::string>& words, std::string_view sep = ", ") {
+  std::string out;
+  for (std::size_t i = 0; i < words.size(); ++i) {
+    if (i) out += sep;
+    out += words[i];
+  }
+  return out;
+}
+
+// "'a' or 'b'" / "one of 'a', 'b', 'c'"
+std::string choices_text(const std::vector<std::string>& options) {
+  std::vector<std::string> quoted;
+  for (const auto& o : options) quoted.push_back("'" + o + "'");
+  if (quoted.size() == 2) return quoted[0] + " or " + quoted[1];
+  return "one of " + join(quoted);
+}
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s << std::setprecision(12) << v;
+  return s.str();
+}
+
+std::string unit_text(std::string_view unit) { return unit.empty() ? std::string() : " [" + std::string(unit) + "]"; }
+
+std::optional<double> parse_number(const YAML::Node& n) {
+  if (!n.IsScalar()) return std::nullopt;
+  std::string_view s = n.Scalar();
+  if (s.size() > 1 && s[0] == '+' && s[1] != '-' && s[1] != '+') s.remove_prefix(1);  // from_chars has no '+'
+  double x = 0.0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), x);
+  if (ec != std::errc() || end != s.data() + s.size() || !std::isfinite(x)) return std::nullopt;
+  return x;
+}
+
+std::optional<long long> parse_integer(const YAML::Node& n) {
+  if (!n.IsScalar()) return std::nullopt;
+  std::string_view s = n.Scalar();
+  if (s.size() > 1 && s[0] == '+' && s[1] != '-' && s[1] != '+') s.remove_prefix(1);
+  long long x = 0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), x);
+  if (ec != std::errc() || end != s.data() + s.size()) return std::nullopt;
+  return x;
+}
+
+// What was found instead of what was expected, for the "got ..." end of a message.
+std::string describe(const YAML::Node& n) {
+  if (!n.IsDefined() || n.IsNull()) return "an empty value";
+  if (n.IsMap()) return "a map";
+  if (n.IsSequence()) {
+    const std::size_t k = n.size();
+    return "a list of " + std::to_string(k) + (k == 1 ? " item" : " items");
+  }
+  const std::string& s = n.Scalar();
+  if (s.empty()) return "an empty string";
+  if (parse_number(n)) return s;
+  return "'" + s + "'";
+}
+
+// A value to check: its node, where it is, and how messages name it ("'particle_spacing'",
+// "item 2 of 'fluids'").
+struct Value {
+  YAML::Node node;
+  YAML::Mark mark;
+  std::string name;
+};
+
+struct NumberRule {
+  std::string text;  // "a positive number"
+  std::function<bool(double)> ok;
+};
+
+NumberRule any_number() { return {"a number", [](double) { return true; }}; }
+NumberRule positive() { return {"a positive number", [](double x) { return x > 0.0; }}; }
+NumberRule non_negative() { return {"a number >= 0", [](double x) { return x >= 0.0; }}; }
+NumberRule open_closed(double lo, double hi) {
+  return {"a number in (" + fmt(lo) + ", " + fmt(hi) + "]", [lo, hi](double x) { return x > lo && x <= hi; }};
+}
+
+class Reader;
+
+// A YAML map with its keys indexed, checked for duplicates and (by check_keys) against the keys
+// the schema allows, so that a typo is reported as such instead of as a missing key.
+class MapView {
+ public:
+  struct Entry {
+    std::string key;
+    YAML::Mark key_mark;
+    YAML::Node value;
+  };
+
+  // `allowed` empty: any key (a map of names, such as 'materials').
+  MapView(const Reader& reader, Value value, std::vector<std::string> allowed, bool check_keys_now = true);
+
+  void check_keys() const;
+  bool has(std::string_view key) const { return find(key) != nullptr; }
+  std::optional<Value> get(std::string_view key) const;
+  Value need(std::string_view key) const;
+  YAML::Mark key_mark(std::string_view key) const { return find(key)->key_mark; }
+  const Value& value() const { return value_; }
+  const std::vector<Entry>& entries() const { return entries_; }
+  Value entry_value(const Entry& e, std::string name) const;
+
+ private:
+  const Entry* find(std::string_view key) const;
+
+  const Reader& reader_;
+  Value value_;
+  std::vector<std::string> allowed_;
+  std::vector<Entry> entries_;
+};
+
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  fsi::Scene read(const std::string& yaml_text);
+
+  [[noreturn]] void fail(const YAML::Mark& mark, const std::string& message) const {
+    const int line = mark.is_null() || mark.line < 0 ? 1 : mark.line + 1;
+    const int column = mark.is_null() || mark.column < 0 ? 1 : mark.column + 1;
+    throw SceneError(file_ + ":" + std::to_string(line) + ":" + std::to_string(column) + ": error: " + message);
+  }
+
+  fsi::SourceLocation where(const YAML::Mark& mark) const {
+    if (mark.is_null()) return {file_, 0, 0};
+    return {file_, mark.line + 1, mark.column + 1};
+  }
+
+  // --- values ---------------------------------------------------------------------------------
+
+  double number(const Value& v, const NumberRule& rule, std::string_view unit = {}) const {
+    const auto x = parse_number(v.node);
+    if (!x || !rule.ok(*x))
+      fail(v.mark, v.name + " must be " + rule.text + unit_text(unit) + ", got " + describe(v.node));
+    return *x;
+  }
+
+  int integer(const Value& v, long long min_value, std::string_view requirement) const {
+    const auto x = parse_integer(v.node);
+    if (!x || *x < min_value || *x > 1000000)
+      fail(v.mark, v.name + " must be " + std::string(requirement) + ", got " + describe(v.node));
+    return static_cast<int>(*x);
+  }
+
+  bool boolean(const Value& v) const {
+    if (v.node.IsScalar()) {
+      const std::string s = to_lower(v.node.Scalar());
+      if (s == "true" || s == "yes" || s == "on") return true;
+      if (s == "false" || s == "no" || s == "off") return false;
+    }
+    fail(v.mark, v.name + " must be true or false, got " + describe(v.node));
+  }
+
+  std::string text(const Value& v, std::string_view what = "a non-empty string") const {
+    if (!v.node.IsScalar() || v.node.Scalar().empty())
+      fail(v.mark, v.name + " must be " + std::string(what) + ", got " + describe(v.node));
+    return v.node.Scalar();
+  }
+
+  std::size_t choice(const Value& v, const std::vector<std::string>& options, std::string_view note = {}) const {
+    if (v.node.IsScalar()) {
+      const auto it = std::find(options.begin(), options.end(), v.node.Scalar());
+      if (it != options.end()) return static_cast<std::size_t>(it - options.begin());
+    }
+    std::string message = v.name + " must be " + choices_text(options) + ", got " + describe(v.node);
+    // A note says why the value is wrong; a guess at a near spelling would then only distract.
+    if (!note.empty())
+      message += " (" + std::string(note) + ")";
+    else if (v.node.IsScalar())
+      message += did_you_mean(v.node.Scalar(), options);
+    fail(v.mark, message);
+  }
+
+  std::vector<Value> list(const Value& v) const {
+    if (!v.node.IsSequence()) fail(v.mark, v.name + " must be a list, got " + describe(v.node));
+    std::vector<Value> items;
+    for (std::size_t i = 0; i < v.node.size(); ++i) {
+      const YAML::Node item = v.node[i];
+      const YAML::Mark mark = item.IsNull() || item.Mark().is_null() ? v.mark : item.Mark();
+      items.push_back({item, mark, "item " + std::to_string(i + 1) + " of " + v.name});
+    }
+    return items;
+  }
+
+  // A point or vector: exactly `dims` numbers; 2D points get z = 0.
+  Vec3d point(const Value& v, int dims, std::string_view unit) const {
+    const std::string shape = dims == 2 ? "[x, y]" : "[x, y, z]";
+    if (!v.node.IsSequence() || static_cast<int>(v.node.size()) != dims)
+      fail(v.mark, v.name + " must be a list of " + std::to_string(dims) + " numbers " + shape +
+                       (unit.empty() ? std::string() : " in " + std::string(unit)) + " in a " + std::to_string(dims) +
+                       "D scene, got " + describe(v.node));
+    Vec3d p{0, 0, 0};
+    for (int k = 0; k < dims; ++k) {
+      const YAML::Node c = v.node[static_cast<std::size_t>(k)];
+      const YAML::Mark mark = c.IsNull() || c.Mark().is_null() ? v.mark : c.Mark();
+      p[static_cast<std::size_t>(k)] =
+          number({c, mark, "component " + std::string(kAxisName[k]) + " of " + v.name}, any_number(), unit);
+    }
+    return p;
+  }
+
+  fsi::Box box(const Value& v, int dims) const {
+    MapView m(*this, v, {"min", "max"});
+    fsi::Box b;
+    b.min = point(m.need("min"), dims, "m");
+    b.max = point(m.need("max"), dims, "m");
+    return b;
+  }
+
+  void require_ordered(const Value& v, const fsi::Box& b, int dims) const {
+    for (int k = 0; k < dims; ++k) {
+      if (!(b.min[k] < b.max[k]))
+        fail(v.mark, v.name + " needs min < max on every axis, got min " + kAxisName[k] + " = " + fmt(b.min[k]) +
+                         " and max " + kAxisName[k] + " = " + fmt(b.max[k]));
+    }
+  }
+
+  const std::string& file() const { return file_; }
+
+ private:
+  void read_numerics(const Value& v, fsi::NumericsSpec& n) const;
+  void read_materials(const Value& v, fsi::Scene& scene) const;
+  void read_walls(const Value& v, fsi::Scene& scene, std::vector<YAML::Mark>& wall_marks) const;
+  void read_fluids(const Value& v, fsi::Scene& scene, const std::vector<YAML::Mark>& wall_marks) const;
+  void read_probes(const Value& v, fsi::Scene& scene) const;
+  void read_output(const Value& v, fsi::OutputSpec& out) const;
+
+  std::string file_;
+};
+
+// --- MapView ------------------------------------------------------------------------------------
+
+MapView::MapView(const Reader& reader, Value value, std::vector<std::string> allowed, bool check_keys_now)
+    : reader_(reader), value_(std::move(value)), allowed_(std::move(allowed)) {
+  if (!value_.node.IsMap()) {
+    std::string keys = allowed_.empty() ? std::string() : " with keys " + join(allowed_);
+    reader_.fail(value_.mark, value_.name + " must be a map" + keys + ", got " + describe(value_.node));
+  }
+  for (auto it = value_.node.begin(); it != value_.node.end(); ++it) {
+    const YAML::Node& k = it->first;
+    if (!k.IsScalar())
+      reader_.fail(k.Mark(), "keys in " + value_.name + " must be plain names, got " + describe(k));
+    const std::string key = k.Scalar();
+    if (const Entry* first = find(key))
+      reader_.fail(k.Mark(), "duplicate key '" + key + "' in " + value_.name + " (first given at line " +
+                                 std::to_string(first->key_mark.line + 1) + ")");
+    entries_.push_back({key, k.Mark(), it->second});
+  }
+  if (check_keys_now) check_keys();
+}
+
+void MapView::check_keys() const {
+  if (allowed_.empty()) return;
+  for (const Entry& e : entries_) {
+    if (std::find(allowed_.begin(), allowed_.end(), e.key) != allowed_.end()) continue;
+    std::string message = "unknown key '" + e.key + "' in " + value_.name;
+    const auto guess = closest(e.key, allowed_);
+    if (guess)
+      message += "; did you mean '" + *guess + "'?";
+    else
+      message += " (expected one of: " + join(allowed_) + ")";
+    reader_.fail(e.key_mark, message);
+  }
+}
+
+const MapView::Entry* MapView::find(std::string_view key) const {
+  for (const Entry& e : entries_)
+    if (e.key == key) return &e;
+  return nullptr;
+}
+
+Value MapView::entry_value(const Entry& e, std::string name) const {
+  // An empty value (`key:` and nothing) has its mark on the next token; point at the key instead.
+  const YAML::Mark mark = e.value.IsNull() || e.value.Mark().is_null() ? e.key_mark : e.value.Mark();
+  return {e.value, mark, std::move(name)};
+}
+
+std::optional<Value> MapView::get(std::string_view key) const {
+  const Entry* e = find(key);
+  if (!e) return std::nullopt;
+  return entry_value(*e, "'" + std::string(key) + "'");
+}
+
+Value MapView::need(std::string_view key) const {
+  const Entry* e = find(key);
+  if (!e) reader_.fail(value_.mark, "missing required key '" + std::string(key) + "' in " + value_.name);
+  return entry_value(*e, "'" + std::string(key) + "'");
+}
+
+// --- the schema ---------------------------------------------------------------------------------
+
+const std::vector<std::string> kTopKeys = {"name",      "dimensions", "resolution", "time",  "gravity", "numerics",
+                                           "materials", "walls",      "fluids",     "probes", "output",  "domain"};
+const std::vector<std::string> kFutureMaterialModels = {"bingham", "herschel_bulkley"};
+
+fsi::Scene Reader::read(const std::string& yaml_text) {
+  std::vector<YAML::Node> documents;
+  try {
+    documents = YAML::LoadAll(yaml_text);
+  } catch (const YAML::Exception& e) {
+    fail(e.mark, "invalid YAML: " + e.msg);
+  }
+  if (documents.empty() || (documents.size() == 1 && documents[0].IsNull()))
+    fail(YAML::Mark::null_mark(), "the scene file is empty; expected a map with the keys " + join(kTopKeys));
+  if (documents.size() > 1)
+    fail(documents[1].Mark(), "the scene file holds more than one YAML document (a '---' line); expected one");
+
+  fsi::Scene scene;
+  scene.source_file = file_;
+  try {
+    const YAML::Node& doc = documents[0];
+    Value root{doc, doc.Mark(), "the scene"};
+    if (!doc.IsMap())
+      fail(root.mark, "the scene must be a map with the keys " + join(kTopKeys) + ", got " + describe(doc));
+    MapView top(*this, root, kTopKeys, false);
+    for (const auto& e : top.entries())
+      if (e.key == "structures")
+        fail(e.key_mark, "'structures' are not supported by the scene reader yet");
+    top.check_keys();
+
+    scene.name = text(top.need("name"));
+    {
+      const Value v = top.need("dimensions");
+      const auto d = parse_integer(v.node);
+      if (!d || (*d != 2 && *d != 3)) fail(v.mark, "'dimensions' must be 2 or 3, got " + describe(v.node));
+      scene.dimensions = static_cast<int>(*d);
+    }
+    const int dims = scene.dimensions;
+    {
+      MapView res(*this, top.need("resolution"), {"particle_spacing", "smoothing_ratio"});
+      scene.particle_spacing = number(res.need("particle_spacing"), positive(), "m");
+      if (auto v = res.get("smoothing_ratio")) scene.smoothing_ratio = number(*v, open_closed(0.5, 3.0));
+    }
+    {
+      MapView time(*this, top.need("time"), {"end", "cfl"});
+      scene.end_time = number(time.need("end"), positive(), "s");
+      if (auto v = time.get("cfl")) scene.numerics.cfl = number(*v, open_closed(0.0, 1.0));
+    }
+    scene.gravity = Vec3d{0, 0, 0};
+    scene.gravity[static_cast<std::size_t>(dims - 1)] = -9.81;
+    if (auto v = top.get("gravity")) scene.gravity = point(*v, dims, "m/s^2");
+    if (auto v = top.get("numerics")) read_numerics(*v, scene.numerics);
+    read_materials(top.need("materials"), scene);
+    if (auto v = top.get("domain")) {
+      fsi::Box b = box(*v, dims);
+      require_ordered(*v, b, dims);
+      scene.domain = b;
+    }
+    std::vector<YAML::Mark> wall_marks;
+    if (auto v = top.get("walls")) read_walls(*v, scene, wall_marks);
+    read_fluids(top.need("fluids"), scene, wall_marks);
+    if (auto v = top.get("probes")) read_probes(*v, scene);
+    if (auto v = top.get("output")) read_output(*v, scene.output);
+  } catch (const YAML::Exception& e) {
+    // Walking a parsed tree should not throw; if yaml-cpp does, keep the promised message form.
+    fail(e.mark, "cannot read the scene: " + e.msg);
+  }
+  return scene;
+}
+
+void Reader::read_numerics(const Value& v, fsi::NumericsSpec& n) const {
+  MapView m(*this, v, {"kernel", "density_diffusion", "viscosity", "min_time_step"});
+  if (auto k = m.get("kernel"))
+    n.kernel = choice(*k, {"wendland_c2", "cubic_spline"}) == 0 ? sph::KernelKind::wendland_c2
+                                                                 : sph::KernelKind::cubic_spline;
+  if (auto dv = m.get("density_diffusion")) {
+    MapView d(*this, *dv, {"type", "delta"});
+    if (auto t = d.get("type"))
+      n.diffusion = static_cast<fsi::DiffusionKind>(choice(*t, {"none", "molteni", "antuono", "fourtakas"}));
+    if (auto delta = d.get("delta")) {
+      if (n.diffusion == fsi::DiffusionKind::none)
+        fail(d.key_mark("delta"), "'delta' has no effect when the density diffusion 'type' is 'none'; remove it");
+      n.diffusion_delta = number(*delta, non_negative());
+    }
+  }
+  if (auto vv = m.get("viscosity")) {
+    MapView visc(*this, *vv, {"type", "alpha"});
+    if (auto t = visc.get("type"))
+      n.viscosity = choice(*t, {"artificial", "laminar"}) == 0 ? fsi::ViscosityKind::artificial
+                                                               : fsi::ViscosityKind::laminar;
+    if (auto alpha = visc.get("alpha")) {
+      if (n.viscosity == fsi::ViscosityKind::laminar)
+        fail(visc.key_mark("alpha"),
+             "'alpha' applies only to 'artificial' viscosity; 'laminar' uses each material's 'viscosity'");
+      n.artificial_viscosity = number(*alpha, non_negative());
+    }
+  }
+  if (auto t = m.get("min_time_step")) n.min_time_step = number(*t, positive(), "s");
+}
+
+void Reader::read_materials(const Value& v, fsi::Scene& scene) const {
+  MapView all(*this, v, {});
+  if (all.entries().empty())
+    fail(v.mark, "'materials' must define at least one material, e.g. 'water: {density: 1000}'");
+  for (const auto& e : all.entries()) {
+    if (e.key.empty()) fail(e.key_mark, "a material needs a non-empty name");
+    MapView m(*this, all.entry_value(e, "material '" + e.key + "'"),
+              {"model", "density", "viscosity", "sound_speed", "gamma", "background_pressure"}, false);
+    fsi::MaterialSpec mat;
+    mat.name = e.key;
+    mat.where = where(e.key_mark);
+    // The model first: keys of a model not supported yet would otherwise be reported as unknown.
+    if (auto model = m.get("model")) {
+      const std::string name = text(*model);
+      if (std::find(kFutureMaterialModels.begin(), kFutureMaterialModels.end(), name) != kFutureMaterialModels.end())
+        fail(model->mark, "material model '" + name + "' is not supported yet; only 'newtonian' is available");
+      if (name != "newtonian") {
+        std::vector<std::string> known = kFutureMaterialModels;
+        known.insert(known.begin(), "newtonian");
+        fail(model->mark, "'model' must be 'newtonian' (the only model supported so far), got '" + name + "'" +
+                              did_you_mean(name, known));
+      }
+      mat.model = name;
+    }
+    m.check_keys();
+    mat.density = number(m.need("density"), positive(), "kg/m^3");
+    if (auto x = m.get("viscosity")) mat.viscosity = number(*x, non_negative(), "Pa s");
+    if (auto x = m.get("sound_speed")) mat.sound_speed = number(*x, positive(), "m/s");
+    if (auto x = m.get("gamma")) mat.gamma = number(*x, positive());
+    if (auto x = m.get("background_pressure")) mat.background_pressure = number(*x, any_number(), "Pa");
+    scene.materials.push_back(mat);
+  }
+}
+
+void Reader::read_walls(const Value& v, fsi::Scene& scene, std::vector<YAML::Mark>& wall_marks) const {
+  const int dims = scene.dimensions;
+  const std::vector<std::string> shapes = {"box", "solid_box", "polyline"};
+  for (const Value& item : list(v)) {
+    MapView m(*this, item, {"box", "solid_box", "polyline", "open", "layers"});
+    std::vector<std::string> present;
+    for (const auto& s : shapes)
+      if (m.has(s)) present.push_back(s);
+    if (present.empty())
+      fail(item.mark, item.name + " needs exactly one of 'box' (a container), 'solid_box' (an obstacle) or "
+                                  "'polyline' (2D), found none");
+    if (present.size() > 1)
+      fail(m.key_mark(present[1]), item.name + " has both '" + present[0] + "' and '" + present[1] +
+                                       "'; give exactly one wall shape per item");
+    fsi::WallSpec wall;
+    wall.where = where(item.mark);
+    const std::string& shape = present[0];
+    if (m.has("open") && shape != "box")
+      fail(m.key_mark("open"), "'open' applies only to a container ('box') wall, not to a '" + shape + "'");
+    if (shape == "box" || shape == "solid_box") {
+      wall.kind = shape == "box" ? fsi::WallSpec::Kind::container : fsi::WallSpec::Kind::solid_box;
+      const Value bv = m.need(shape);
+      wall.box = box(bv, dims);
+      require_ordered(bv, wall.box, dims);
+    } else {
+      if (dims != 2)
+        fail(m.key_mark("polyline"), "'polyline' walls exist only in 2D scenes, but this scene has dimensions: " +
+                                         std::to_string(dims) + "; use 'box' or 'solid_box'");
+      wall.kind = fsi::WallSpec::Kind::polyline;
+      MapView pl(*this, m.need("polyline"), {"points", "closed", "side"});
+      if (auto c = pl.get("closed")) wall.closed = boolean(*c);
+      if (auto s = pl.get("side")) wall.side = choice(*s, {"right", "left"}) == 0 ? -1 : +1;
+      const Value pv = pl.need("points");
+      const std::vector<Value> points = list(pv);
+      const std::size_t needed = wall.closed ? 3 : 2;
+      if (points.size() < needed)
+        fail(pv.mark, "'points' of a " + std::string(wall.closed ? "closed " : "") + "polyline needs at least " +
+                          std::to_string(needed) + " points, got " + describe(pv.node));
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        Value p = points[i];
+        p.name = "point " + std::to_string(i + 1) + " of 'points'";
+        wall.points.push_back(point(p, dims, "m"));
+        if (i > 0 && wall.points[i] == wall.points[i - 1])
+          fail(p.mark, p.name + " repeats the point before it; a segment needs two distinct points");
+      }
+    }
+    if (auto o = m.get("open")) {
+      std::vector<std::string> faces(kFaceName, kFaceName + 2 * dims);
+      for (const Value& f : list(*o)) {
+        Value face = f;
+        face.name = "a face in 'open'";
+        const bool z_in_2d = dims == 2 && f.node.IsScalar() && (f.node.Scalar() == "-z" || f.node.Scalar() == "+z");
+        const std::size_t k = choice(face, faces, z_in_2d ? "a 2D scene has no z faces" : "");
+        if (wall.open[k]) fail(f.mark, "face '" + faces[k] + "' is listed twice in 'open'");
+        wall.open[k] = true;
+      }
+    }
+    if (auto l = m.get("layers")) wall.layers = integer(*l, 1, "an integer >= 1");
+    scene.walls.push_back(wall);
+    wall_marks.push_back(item.mark);
+  }
+}
+
+void Reader::read_fluids(const Value& v, fsi::Scene& scene, const std::vector<YAML::Mark>& wall_marks) const {
+  const int dims = scene.dimensions;
+  const double dx = scene.particle_spacing;
+  const double tol = 1e-9 * dx;
+  std::vector<std::string> material_names;
+  for (const auto& m : scene.materials) material_names.push_back(m.name);
+
+  const std::vector<Value> items = list(v);
+  if (items.empty()) fail(v.mark, "'fluids' must list at least one fluid block");
+  for (const Value& item : items) {
+    MapView m(*this, item, {"material", "box"});
+    fsi::FluidBlock block;
+    block.where = where(item.mark);
+    const Value mv = m.need("material");
+    block.material = text(mv);
+    if (std::find(material_names.begin(), material_names.end(), block.material) == material_names.end())
+      fail(mv.mark, "unknown material '" + block.material + "' in " + item.name +
+                        did_you_mean(block.material, material_names) + " (defined materials: " +
+                        join(material_names) + ")");
+    const Value bv = m.need("box");
+    block.box = box(bv, dims);
+    const fsi::Box& b = block.box;
+    for (int k = 0; k < dims; ++k) {
+      if (b.min[k] > b.max[k]) require_ordered(bv, b, dims);
+      if (b.min[k] == b.max[k])
+        fail(bv.mark, "empty fluid region: the fluid 'box' has zero extent along " + std::string(kAxisName[k]) +
+                          " (min = max = " + fmt(b.min[k]) + ")");
+    }
+    for (int k = 0; k < dims; ++k) {
+      const double extent = b.max[k] - b.min[k];
+      if (extent < dx - tol)
+        fail(bv.mark, "the fluid 'box' is " + fmt(extent) + " m wide along " + kAxisName[k] +
+                          ", less than particle_spacing = " + fmt(dx) +
+                          " m, so it would hold fewer than one particle per axis");
+    }
+    for (std::size_t w = 0; w < scene.walls.size(); ++w) {
+      const fsi::WallSpec& wall = scene.walls[w];
+      if (wall.kind == fsi::WallSpec::Kind::polyline) continue;
+      const fsi::Box& c = wall.box;
+      bool overlaps = true;
+      for (int k = 0; k < dims; ++k) overlaps = overlaps && b.min[k] < c.max[k] - tol && c.min[k] < b.max[k] - tol;
+      if (!overlaps) continue;
+      const std::string wall_name = "item " + std::to_string(w + 1) + " of 'walls' (line " +
+                                    std::to_string(wall_marks[w].line + 1) + ")";
+      if (wall.kind == fsi::WallSpec::Kind::solid_box)
+        fail(bv.mark, "the fluid 'box' overlaps the 'solid_box' of " + wall_name +
+                          "; fluid and wall particles would fill the same space");
+      // A container: fluid that reaches into it must stay inside, except through an open face.
+      for (int k = 0; k < dims; ++k) {
+        const std::string axis = kAxisName[k];
+        if (!wall.open[2 * k] && b.min[k] < c.min[k] - tol)
+          fail(bv.mark, "the fluid 'box' pokes out of the container 'box' of " + wall_name + " through its -" + axis +
+                            " face (fluid min " + axis + " = " + fmt(b.min[k]) + " < container min " + axis + " = " +
+                            fmt(c.min[k]) + "); a fluid block must lie inside the container");
+        if (!wall.open[2 * k + 1] && b.max[k] > c.max[k] + tol)
+          fail(bv.mark, "the fluid 'box' pokes out of the container 'box' of " + wall_name + " through its +" + axis +
+                            " face (fluid max " + axis + " = " + fmt(b.max[k]) + " > container max " + axis + " = " +
+                            fmt(c.max[k]) + "); a fluid block must lie inside the container");
+      }
+    }
+    if (scene.domain) {
+      const fsi::Box& d = *scene.domain;
+      for (int k = 0; k < dims; ++k)
+        if (b.min[k] < d.min[k] - tol || b.max[k] > d.max[k] + tol)
+          fail(bv.mark, std::string("the fluid 'box' reaches outside 'domain' along ") + kAxisName[k] + " (fluid " +
+                            fmt(b.min[k]) + " to " + fmt(b.max[k]) + ", domain " + fmt(d.min[k]) + " to " +
+                            fmt(d.max[k]) + "); its particles would be removed at the start");
+    }
+    scene.fluids.push_back(block);
+  }
+}
+
+void Reader::read_probes(const Value& v, fsi::Scene& scene) const {
+  const int dims = scene.dimensions;
+  std::vector<std::string> material_names;
+  for (const auto& m : scene.materials) material_names.push_back(m.name);
+  const std::vector<std::string> types = {"front_position", "pressure", "max_speed", "kinetic_energy",
+                                          "fluid_particles"};
+  std::map<std::string, int> first_line;
+  for (const Value& item : list(v)) {
+    MapView m(*this, item, {"name", "type", "material", "axis", "point"});
+    fsi::ProbeSpec probe;
+    probe.where = where(item.mark);
+    const Value nv = m.need("name");
+    probe.name = text(nv);
+    if (const auto bad = probe.name.find_first_of(",\"\n\r"); bad != std::string::npos) {
+      const char c = probe.name[bad];
+      const std::string what = c == ',' ? "a comma" : c == '"' ? "a double quote" : "a line break";
+      fail(nv.mark, "probe name '" + probe.name + "' contains " + what +
+                        " and cannot be a CSV column header; use letters, digits, '_' or '-'");
+    }
+    if (const auto it = first_line.find(probe.name); it != first_line.end())
+      fail(nv.mark, "duplicate probe name '" + probe.name + "' (first used at line " + std::to_string(it->second) +
+                        "); probe names must be unique");
+    first_line[probe.name] = nv.mark.line + 1;
+
+    const Value tv = m.need("type");
+    const std::size_t t = choice(tv, types);
+    probe.type = static_cast<fsi::ProbeSpec::Type>(t);
+    std::vector<std::string> uses;
+    if (probe.type == fsi::ProbeSpec::Type::front_position) uses = {"material", "axis"};
+    if (probe.type == fsi::ProbeSpec::Type::pressure) uses = {"point"};
+    for (const char* key : {"material", "axis", "point"})
+      if (m.has(key) && std::find(uses.begin(), uses.end(), key) == uses.end())
+        fail(m.key_mark(key), "'" + std::string(key) + "' does not apply to a '" + types[t] + "' probe");
+
+    if (auto mv = m.get("material")) {
+      probe.material = text(*mv);
+      if (std::find(material_names.begin(), material_names.end(), probe.material) == material_names.end())
+        fail(mv->mark, "unknown material '" + probe.material + "' in probe '" + probe.name + "'" +
+                           did_you_mean(probe.material, material_names) + " (defined materials: " +
+                           join(material_names) + ")");
+    }
+    if (auto av = m.get("axis")) {
+      std::vector<std::string> axes(kAxisName, kAxisName + dims);
+      const bool z_in_2d = dims == 2 && av->node.IsScalar() && av->node.Scalar() == "z";
+      probe.axis = static_cast<int>(choice(*av, axes, z_in_2d ? "a 2D scene has no z axis" : ""));
+    }
+    if (probe.type == fsi::ProbeSpec::Type::pressure) probe.point = point(m.need("point"), dims, "m");
+    scene.probes.push_back(probe);
+  }
+}
+
+void Reader::read_output(const Value& v, fsi::OutputSpec& out) const {
+  MapView m(*this, v, {"every", "vtk", "checkpoint_every"});
+  if (auto x = m.get("every")) out.every = number(*x, non_negative(), "s");
+  if (auto x = m.get("vtk")) out.vtk = boolean(*x);
+  if (auto x = m.get("checkpoint_every")) out.checkpoint_every = number(*x, non_negative(), "s");
+}
+
+}  // namespace
+
+fsi::Scene read_scene_string(const std::string& yaml_text, const std::string& file_name_for_messages) {
+  return Reader(file_name_for_messages).read(yaml_text);
+}
+
+fsi::Scene read_scene_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw SceneError(path + ":1:1: error: this is a directory, not a scene file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    const int err = errno;
+    throw SceneError(path + ":1:1: error: cannot open the scene file (" +
+                     (err ? std::string(std::strerror(err)) : std::string("unknown reason")) + ")");
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw SceneError(path + ":1:1: error: cannot read the scene file");
+  return read_scene_string(text.str(), path);
+}
+
+}  // namespace turbid::tools

@@ -1,0 +1,28 @@
+// The scene-file reader: YAML text -> the plain fsi::Scene the engine runs. Every error it reports
+// names the file, the line and the column and says what was expected, in the compiler-like form
+// "FILE:LINE:COL: error: WHAT", so that editors and CI logs can jump to it. YAML stays inside
+// tools/: this header includes no yaml-cpp header.
+#pragma once
+#include <stdexcept>
+#include <string>
+
+#include "fsi/scene.hpp"
+
+namespace turbid::tools {
+
+// A scene that cannot be run. what() is "FILE:LINE:COL: error: MESSAGE" (1-based line and column);
+// errors that belong to no line (a missing file, an empty file) point at 1:1.
+struct SceneError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Reads and checks a scene file. Throws SceneError for a missing or unreadable file, a YAML syntax
+// error, a schema error (unknown or missing key, wrong type, value out of range) or a semantic error
+// (unknown material, overlapping regions, ...). Fills Scene::source_file and every `where`.
+fsi::Scene read_scene_file(const std::string& path);
+
+// The same for YAML text held in memory; `file_name_for_messages` is used in error messages and as
+// Scene::source_file.
+fsi::Scene read_scene_string(const std::string& yaml_text, const std::string& file_name_for_messages);
+
+}  // namespace turbid::tools
