@@ -48,7 +48,7 @@ struct FluidBlock {
 struct WallSpec {
   enum class Kind {
     container,  // layers of particles outside the faces of `box` (a tank); faces in `open` are left out
-    solid_box,  // `box` filled with boundary particles (an obstacle)
+    solid_box,  // `box` filled with boundary particles (an obstacle); with `layers`, only a shell that thick
     polyline,   // 2D: a chain of segments through `points`, layers on the side given by `side`
   };
   Kind kind = Kind::container;
@@ -58,7 +58,7 @@ struct WallSpec {
   std::vector<Vec3d> points;  // polyline vertices (2D)
   bool closed = false;        // polyline: connect the last point to the first
   int side = -1;              // polyline: layers on the right (-1) or left (+1) of the direction of travel
-  int layers = 0;             // number of particle layers; 0 = enough for the kernel support
+  int layers = 0;             // number of particle layers; 0 = enough for the kernel support (solid_box: full)
   SourceLocation where;
 };
 

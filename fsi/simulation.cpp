@@ -74,6 +74,7 @@ sph::PhysicsParams physics_params(const Scene& scene) {
   p.artificial_viscosity = sph::Real(scene.numerics.artificial_viscosity);
   p.smoothing_length = sph::Real(scene.smoothing_ratio * scene.particle_spacing);
   p.uniform_h = true;
+  p.max_smoothing_length = p.smoothing_length;
   for (int k = 0; k < 3; ++k) p.gravity[k] = sph::Real(k < scene.dimensions ? scene.gravity[k] : 0.0);
   if (scene.materials.empty()) throw std::invalid_argument("the scene declares no material");
   if (int(scene.materials.size()) > sph::kMaxMaterials)
@@ -166,7 +167,7 @@ void Simulation::build_particles() {
     std::vector<geometry::Point> pts;
     switch (w.kind) {
       case WallSpec::Kind::container: pts = geometry::container_walls(to_aabb(w.box), dx, d, layers, w.open); break;
-      case WallSpec::Kind::solid_box: pts = geometry::fill_box(to_aabb(w.box), dx, d); break;
+      case WallSpec::Kind::solid_box: pts = geometry::box_shell(to_aabb(w.box), dx, d, w.layers); break;
       case WallSpec::Kind::polyline: pts = geometry::polyline_walls(w.points, w.closed, dx, layers, w.side); break;
     }
     for (const auto& x : pts) {

@@ -30,6 +30,22 @@ std::vector<Point> fill_box(const Aabb& box, double dx, int dims) {
   return pts;
 }
 
+std::vector<Point> box_shell(const Aabb& box, double dx, int dims, int layers) {
+  if (layers <= 0) return fill_box(box, dx, dims);
+  int n[3] = {1, 1, 1};
+  for (int k = 0; k < dims; ++k) n[k] = cells_along(box.max[k] - box.min[k], dx);
+  std::vector<Point> pts;
+  for (const auto& p : fill_box(box, dx, dims)) {
+    bool near_surface = false;
+    for (int k = 0; k < dims; ++k) {
+      const int i = int(std::floor((p[k] - box.min[k]) / dx));
+      near_surface = near_surface || i < layers || i >= n[k] - layers;
+    }
+    if (near_surface) pts.push_back(p);
+  }
+  return pts;
+}
+
 std::vector<Point> container_walls(const Aabb& box, double dx, int dims, int layers,
                                    const std::array<bool, 6>& open) {
   if (!(dx > 0)) throw std::invalid_argument("container_walls: spacing must be positive");

@@ -16,6 +16,10 @@ struct Aabb {
 // Cell-centred lattice points (spacing dx) inside [min, max] in the first `dims` axes.
 std::vector<Point> fill_box(const Aabb& box, double dx, int dims);
 
+// Lattice points of fill_box within `layers` spacings of the box surface (a hollow shell);
+// layers <= 0 fills the whole box.
+std::vector<Point> box_shell(const Aabb& box, double dx, int dims, int layers);
+
 // `layers` layers of lattice points outside the faces of `box` (a tank), continuing the
 // cell-centred lattice of fill_box so that wall and fluid particles are exactly dx apart.
 // open[2k] / open[2k+1] leave out the -/+ face of axis k; corners and edges are filled

@@ -28,6 +28,10 @@ struct ParticleView {
   std::uint8_t* material = nullptr;
   std::uint8_t* kind = nullptr;
   Vec<D>* density_gradient = nullptr;  // only with Antuono diffusion
+  // CPU only: positions as one array per coordinate (component a at a * soa_stride), a copy made
+  // at each sort so that distance checks vectorise; valid until the next drift.
+  const Real* position_soa = nullptr;
+  std::size_t soa_stride = 0;
   std::uint32_t count = 0;
 };
 
@@ -38,6 +42,84 @@ template <int D, class K>
 TURBID_HD inline Real pair_h(const ParticleView<D>& P, const PhysicsParams& prm, bool uniform, Real h_i, std::uint32_t j) {
   // A pair of different smoothing lengths uses the kernel of the mean h (symmetric in i and j).
   return uniform ? prm.smoothing_length : Real(0.5) * (h_i + P.smoothing_length[j]);
+}
+
+// An optional per-particle neighbour list (CPU backend): the momentum pass records, for each
+// particle, the indices of its neighbours within the support in grid order; the continuity pass of
+// the next step runs on the same positions and reads them instead of searching the grid again.
+// A particle with more neighbours than `stride` falls back to the grid (same order, same sums).
+struct NeighbourList {
+  std::uint32_t* entries = nullptr;  // stride entries per particle
+  std::uint32_t* count = nullptr;    // neighbours of each particle (> stride: overflowed)
+  std::uint32_t stride = 0;
+  bool record = false;               // true: fill the list while searching the grid
+};
+
+// Calls f(j, r_ij, r_ij^2) for every j != i with r_ij < 2 h_max, in grid order.
+template <int D, class F>
+TURBID_HD inline void for_each_neighbour(const ParticleView<D>& P, const GridView<D>& G, const NeighbourList& L,
+                                         const PhysicsParams& prm, std::uint32_t i, const Vec<D>& xi, F&& f) {
+  const Real support2 = Real(4) * prm.max_smoothing_length * prm.max_smoothing_length;
+  if (L.entries && !L.record && L.count[i] <= L.stride) {
+    const std::uint32_t* list = L.entries + std::size_t(i) * L.stride;
+    const std::uint32_t n = L.count[i];
+    for (std::uint32_t k = 0; k < n; ++k) {
+      const std::uint32_t j = list[k];
+      const Vec<D> rij = xi - P.position[j];
+      f(j, rij, norm2(rij));
+    }
+    return;
+  }
+  int c[D] = {};
+  G.cell_of(xi, c);
+  std::uint32_t n = 0;
+  std::uint32_t* out = L.record ? L.entries + std::size_t(i) * L.stride : nullptr;
+#if !defined(__CUDA_ARCH__)
+  if (P.position_soa) {
+    // CPU: distances of a whole cell range in one vectorisable loop over coordinate arrays, then
+    // the (few) pairs inside the support; same order as the plain loop below.
+    constexpr std::uint32_t kChunk = 64;
+    Real r2buf[kChunk];
+    G.for_each_neighbour_range(c, [&](std::uint32_t b, std::uint32_t e) {
+      for (std::uint32_t b0 = b; b0 < e; b0 += kChunk) {
+        const std::uint32_t len = e - b0 < kChunk ? e - b0 : kChunk;
+        for (std::uint32_t k = 0; k < len; ++k) {
+          Real r2 = 0;
+          for (int a = 0; a < D; ++a) {
+            const Real d = xi[a] - P.position_soa[std::size_t(a) * P.soa_stride + b0 + k];
+            r2 += d * d;
+          }
+          r2buf[k] = r2;
+        }
+        for (std::uint32_t k = 0; k < len; ++k) {
+          const std::uint32_t j = b0 + k;
+          if (r2buf[k] >= support2 || j == i) continue;
+          if (out) {
+            if (n < L.stride) out[n] = j;
+            ++n;
+          }
+          const Vec<D> rij = xi - P.position[j];
+          f(j, rij, norm2(rij));
+        }
+      }
+    });
+    if (out) L.count[i] = n;
+    return;
+  }
+#endif
+  G.for_each_neighbour_range(c, [&](std::uint32_t b, std::uint32_t e) {
+    for (std::uint32_t j = b; j < e; ++j) {
+      const Vec<D> rij = xi - P.position[j];
+      const Real r2 = norm2(rij);
+      if (r2 >= support2 || j == i) continue;
+      if (out) {
+        if (n < L.stride) out[n] = j;
+        ++n;
+      }
+      f(j, rij, r2);
+    }
+  });
+  if (out) L.count[i] = n;
 }
 
 // Pressure from density with each material's equation of state (walls use wall_material's).
@@ -60,6 +142,7 @@ struct DensityGradientPass {
   ParticleView<D> P;
   GridView<D> G;
   PhysicsParams prm;
+  NeighbourList L;
   TURBID_HD void operator()(std::uint32_t i) const {
     Vec<D> g = Vec<D>::zero();
     if (P.kind[i] != std::uint8_t(Kind::fluid)) {
@@ -71,22 +154,16 @@ struct DensityGradientPass {
     const Real h_i = UniformH ? prm.smoothing_length : P.smoothing_length[i];
     const std::uint8_t mat_i = P.material[i];
     Real M[D][D] = {};
-    int c[D] = {};
-    G.cell_of(xi, c);
-    G.for_each_neighbour_range(c, [&](std::uint32_t b, std::uint32_t e) {
-      for (std::uint32_t j = b; j < e; ++j) {
-        if (j == i || P.kind[j] != std::uint8_t(Kind::fluid) || P.material[j] != mat_i) continue;
-        const Vec<D> rij = xi - P.position[j];
-        const Real r2 = norm2(rij);
+    for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
+        if (P.kind[j] != std::uint8_t(Kind::fluid) || P.material[j] != mat_i || r2 == Real(0)) return;
         const Real h = pair_h<D, K>(P, prm, UniformH, h_i, j);
-        if (r2 >= Real(4) * h * h || r2 == Real(0)) continue;
+        if (!UniformH && r2 >= Real(4) * h * h) return;
         const Real F = K::f(std::sqrt(r2), h);
         const Real vol = P.mass[j] / P.density[j];
         for (int a = 0; a < D; ++a) {
           g[a] += (P.density[j] - rho_i) * F * rij[a] * vol;
           for (int b2 = 0; b2 < D; ++b2) M[a][b2] -= rij[a] * F * rij[b2] * vol;  // r_ji (x) grad W
         }
-      }
     });
     // Solve M^T-free: L = M^-1 applied to g (M is symmetric here).
     Real det;
@@ -128,6 +205,7 @@ struct ContinuityPass {
   ParticleView<D> P;
   GridView<D> G;
   PhysicsParams prm;
+  NeighbourList L;
 
   TURBID_HD void operator()(std::uint32_t i) const {
     const Vec<D> xi = P.position[i];
@@ -143,16 +221,11 @@ struct ContinuityPass {
     const Real hydro_k = Mi.eos.rest_density / Mi.eos.stiffness;
 
     Real drho = 0;
-    int c[D] = {};
-    G.cell_of(xi, c);
-    G.for_each_neighbour_range(c, [&](std::uint32_t b, std::uint32_t e) {
-      for (std::uint32_t j = b; j < e; ++j) {
-        const Vec<D> rij = xi - P.position[j];
-        const Real r2 = norm2(rij);
+    for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
         const Real h = pair_h<D, K>(P, prm, UniformH, h_i, j);
-        if (r2 >= Real(4) * h * h || j == i) continue;
+        if (!UniformH && r2 >= Real(4) * h * h) return;
         const bool fluid_j = P.kind[j] == std::uint8_t(Kind::fluid);
-        if (!fluid_i && !fluid_j) continue;
+        if (!fluid_i && !fluid_j) return;
         const Real F = K::f(std::sqrt(r2), h);
         const Real rho_j = P.density[j];
         const Real vol_j = P.mass[j] / rho_j;
@@ -174,7 +247,6 @@ struct ContinuityPass {
             }
           }
         }
-      }
     });
     P.density_rate[i] = drho;
   }
@@ -186,11 +258,13 @@ struct MomentumPass {
   ParticleView<D> P;
   GridView<D> G;
   PhysicsParams prm;
+  NeighbourList L;
 
   TURBID_HD void operator()(std::uint32_t i) const {
     Vec<D> acc = Vec<D>::zero();
     if (P.kind[i] != std::uint8_t(Kind::fluid)) {
       P.acceleration[i] = acc;
+      if (L.record) L.count[i] = L.stride + 1;  // no list for walls: their continuity searches the grid
       return;
     }
     const Vec<D> xi = P.position[i];
@@ -200,14 +274,9 @@ struct MomentumPass {
     const Real h_i = UniformH ? prm.smoothing_length : P.smoothing_length[i];
     const MaterialParams& Mi = prm.materials[P.material[i]];
     const bool artificial = prm.viscosity == Viscosity::artificial;
-    int c[D] = {};
-    G.cell_of(xi, c);
-    G.for_each_neighbour_range(c, [&](std::uint32_t b, std::uint32_t e) {
-      for (std::uint32_t j = b; j < e; ++j) {
-        const Vec<D> rij = xi - P.position[j];
-        const Real r2 = norm2(rij);
+    for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
         const Real h = pair_h<D, K>(P, prm, UniformH, h_i, j);
-        if (r2 >= Real(4) * h * h || j == i) continue;
+        if (!UniformH && r2 >= Real(4) * h * h) return;
         const Real F = K::f(std::sqrt(r2), h);
         const Real rho_j = P.density[j];
         const Real m_j = P.mass[j];
@@ -224,7 +293,6 @@ struct MomentumPass {
           acc += s * rij;
           acc += pair::laminar_viscosity(m_j, Mi.dynamic_viscosity, Mj.dynamic_viscosity, rho_i, rho_j, r2, eta2, F) * vij;
         }
-      }
     });
     for (int k = 0; k < D; ++k) acc[k] += prm.gravity[k];
     P.acceleration[i] = acc;

@@ -31,6 +31,7 @@ struct PhysicsParams {
   Real artificial_viscosity = Real(0.01);
   Real smoothing_length = 0;   // h of the initial lattice [m]
   bool uniform_h = true;       // every particle has h == smoothing_length (fast path)
+  Real max_smoothing_length = 0;  // largest h present [m]; the neighbour search covers 2 h_max
   Real gravity[3] = {0, 0, 0}; // [m/s^2]
   int material_count = 0;
   int wall_material = 0;       // EOS used for wall particles' pressure

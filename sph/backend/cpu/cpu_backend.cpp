@@ -45,6 +45,7 @@ class CpuBackend final : public Backend {
   }
 
   std::size_t update_neighbours() override {
+    list_valid_ = false;
     return params_.dimensions == 2 ? sort_by_cell<2>() : sort_by_cell<3>();
   }
 
@@ -64,6 +65,7 @@ class CpuBackend final : public Backend {
   }
 
   void drift(double dt) override {
+    soa_valid_ = false;
     if (params_.dimensions == 2) drift_impl<2>(Real(dt));
     else drift_impl<3>(Real(dt));
   }
@@ -101,6 +103,10 @@ class CpuBackend final : public Backend {
     v.kind = s.data<std::uint8_t>(ids_.kind);
     if (ids_.density_gradient >= 0) v.density_gradient = s.data<Vec<D>>(ids_.density_gradient);
     v.count = std::uint32_t(s.size());
+    if (soa_valid_) {
+      v.position_soa = soa_.data();
+      v.soa_stride = soa_stride_;
+    }
     return v;
   }
 
@@ -114,6 +120,36 @@ class CpuBackend final : public Backend {
     g.inv_cell = Real(inv_cell_);
     g.cell_start = cell_start_.data();
     return g;
+  }
+
+  // The neighbour list recorded by the momentum pass, reused by the next continuity pass (same
+  // positions). Invalid after every sort.
+  NeighbourList list(bool record) {
+    NeighbourList L;
+    if (!record && !list_valid_) return L;
+    const std::size_t n = store_->size();
+    if (record) {
+      if (list_stride_ == 0) {
+        // 1.5 x the lattice particles in the support sphere (circle in 2D), rounded up to 8.
+        const double r = 2.0 * params_.max_smoothing_length / spacing_estimate();
+        const double inside = params_.dimensions == 2 ? 3.14159265 * r * r : 4.18879 * r * r * r;
+        list_stride_ = (std::uint32_t(1.5 * inside) + 15u) & ~7u;
+      }
+      if (list_entries_.size() < n * list_stride_) list_entries_.resize(n * list_stride_);
+      if (list_count_.size() < n) list_count_.resize(n);
+    }
+    L.entries = list_entries_.data();
+    L.count = list_count_.data();
+    L.stride = list_stride_;
+    L.record = record;
+    return L;
+  }
+
+  double spacing_estimate() const {
+    // Volume per particle of the initial lattice, from the first particle's mass and density.
+    const double m = store_->data<Real>(ids_.mass)[0];
+    const double rho = store_->data<Real>(ids_.density)[0];
+    return std::pow(m / rho, 1.0 / params_.dimensions);
   }
 
   template <int D>
@@ -143,6 +179,16 @@ class CpuBackend final : public Backend {
     store_->permute(order_.data());
     const std::uint32_t kept = cell_start_[cell_count_];
     store_->resize(kept);
+    // Coordinate arrays for the vectorised distance checks of the passes that follow.
+    soa_stride_ = kept;
+    soa_.resize(std::size_t(D) * kept);
+    const Vec<D>* xs = store_->data<Vec<D>>(ids_.position);
+    Real* soa = soa_.data();
+    const std::size_t stride = soa_stride_;
+    parallel_for(kept, [=](std::uint32_t i) {
+      for (int a = 0; a < D; ++a) soa[std::size_t(a) * stride + i] = xs[i][a];
+    });
+    soa_valid_ = true;
     return n - kept;
   }
 
@@ -154,10 +200,10 @@ class CpuBackend final : public Backend {
       using K = typename decltype(kernel_tag)::type;
       constexpr bool U = decltype(uniform_tag)::value;
       if (params_.diffusion == Diffusion::antuono)
-        parallel_for(P.count, DensityGradientPass<D, K, U>{P, G, params_});
+        parallel_for(P.count, DensityGradientPass<D, K, U>{P, G, params_, list(false)});
       dispatch_diffusion(params_.diffusion, [&](auto diff_tag) {
         constexpr Diffusion Df = decltype(diff_tag)::value;
-        parallel_for(P.count, ContinuityPass<D, K, Df, U>{P, G, params_});
+        parallel_for(P.count, ContinuityPass<D, K, Df, U>{P, G, params_, list(false)});
       });
     });
   }
@@ -170,8 +216,9 @@ class CpuBackend final : public Backend {
     dispatch_kernel<D>(params_, [&](auto kernel_tag, auto uniform_tag) {
       using K = typename decltype(kernel_tag)::type;
       constexpr bool U = decltype(uniform_tag)::value;
-      parallel_for(P.count, MomentumPass<D, K, U>{P, G, params_});
+      parallel_for(P.count, MomentumPass<D, K, U>{P, G, params_, list(true)});
     });
+    list_valid_ = true;
   }
 
   template <int D>
@@ -277,6 +324,12 @@ class CpuBackend final : public Backend {
   double inv_cell_ = 1;
   std::size_t cell_count_ = 1;
   std::vector<std::uint32_t> cell_start_, cursor_, keys_, order_;
+  std::vector<std::uint32_t> list_entries_, list_count_;
+  std::uint32_t list_stride_ = 0;
+  bool list_valid_ = false;
+  std::vector<Real> soa_;
+  std::size_t soa_stride_ = 0;
+  bool soa_valid_ = false;
 };
 
 }  // namespace
