@@ -153,6 +153,17 @@ void Simulation::build_particles() {
     const std::uint8_t m = material_of(f.material, f.where);
     const auto& eos = params_.materials[m].eos;
     const double top = box_top(s, f.box);
+    // Weak compressibility: the hydrostatic density at the bottom must stay near rho0.
+    const double bottom_ratio = eos.hydrostatic_density(g, top - box_bottom(s, f.box)) / eos.rest_density - 1.0;
+    if (bottom_ratio > 0.1) {
+      const auto& ms = s.materials[m];
+      std::ostringstream os;
+      os << ms.where.file << ":" << ms.where.line << ":" << ms.where.column << ": error: material '" << ms.name
+         << "': sound speed " << params_.materials[m].sound_speed << " m/s compresses the " << (top - box_bottom(s, f.box))
+         << " m column by " << 100 * bottom_ratio << "% at rest; weakly compressible SPH needs about 1% (sound speed >= "
+         << 10 * std::sqrt(2 * g * (top - box_bottom(s, f.box))) << " m/s, ten times the free-fall speed)";
+      throw std::invalid_argument(os.str());
+    }
     for (const auto& x : geometry::fill_box(to_aabb(f.box), dx, d)) {
       const double depth = std::max(0.0, top - height_of(s, x));
       items.push_back({x, eos.hydrostatic_density(g, depth), m, sph::Kind::fluid});

@@ -105,10 +105,10 @@ void ParticleStore::permute(const std::uint32_t* order) {
     if (fb == 4) {
       auto* s = reinterpret_cast<const std::uint32_t*>(src);
       auto* d = reinterpret_cast<std::uint32_t*>(dst);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= 4096)
       for (std::ptrdiff_t i = 0; i < n; ++i) d[i] = s[order[i]];
     } else {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= 4096)
       for (std::ptrdiff_t i = 0; i < n; ++i) std::memcpy(dst + std::size_t(i) * fb, src + std::size_t(order[i]) * fb, fb);
     }
     std::memcpy(src, dst, size_ * fb);

@@ -29,7 +29,7 @@ Solver::Solver(ParticleStore& store, const FieldIds& ids, const PhysicsParams& p
 void Solver::start() {
   removed_ += backend_->update_neighbours();
   backend_->compute_forces();
-  check("initial forces");
+  check("the initial state, step");
 }
 
 void Solver::resume(double time, std::uint64_t steps, std::uint64_t removed) {

@@ -199,15 +199,6 @@ nlohmann::json run_scene(const RunRequest& request) {
   const double mass_start = fluid_mass(sim);
   Writers writers(out, sim.scene(), resume_time, request.progress);
 
-  if (request.resume) {
-    const auto state = read_checkpoint(*request.resume / "checkpoint", sim.store());
-    sim.resume(state.at("time").get<double>(), state.at("steps").get<std::uint64_t>(),
-               state.at("removed").get<std::uint64_t>(), state.at("output_index").get<std::uint64_t>(),
-               state.at("checkpoint_index").get<std::uint64_t>(), state.at("particle_steps").get<std::uint64_t>());
-  } else {
-    sim.start();
-  }
-  writers.start_clock(sim);
 
   nlohmann::json report;
   report["scene"] = scene.name;
@@ -224,6 +215,15 @@ nlohmann::json run_scene(const RunRequest& request) {
                      {"fluid_mass", scene.dimensions == 2 ? "kg/m" : "kg"}};
   std::string status = "completed";
   try {
+    if (request.resume) {
+      const auto state = read_checkpoint(*request.resume / "checkpoint", sim.store());
+      sim.resume(state.at("time").get<double>(), state.at("steps").get<std::uint64_t>(),
+                 state.at("removed").get<std::uint64_t>(), state.at("output_index").get<std::uint64_t>(),
+                 state.at("checkpoint_index").get<std::uint64_t>(), state.at("particle_steps").get<std::uint64_t>());
+    } else {
+      sim.start();
+    }
+    writers.start_clock(sim);
     sim.run(writers);
   } catch (const sph::BlowUp& e) {
     status = "blow-up";

@@ -445,7 +445,7 @@ fsi::Scene Reader::read(const std::string& yaml_text) {
 }
 
 void Reader::read_numerics(const Value& v, fsi::NumericsSpec& n) const {
-  MapView m(*this, v, {"kernel", "density_diffusion", "viscosity", "min_time_step"});
+  MapView m(*this, v, {"kernel", "density_diffusion", "viscosity", "min_time_step", "max_density_variation"});
   if (auto k = m.get("kernel"))
     n.kernel = choice(*k, {"wendland_c2", "cubic_spline"}) == 0 ? sph::KernelKind::wendland_c2
                                                                  : sph::KernelKind::cubic_spline;
@@ -472,6 +472,8 @@ void Reader::read_numerics(const Value& v, fsi::NumericsSpec& n) const {
     }
   }
   if (auto t = m.get("min_time_step")) n.min_time_step = number(*t, positive(), "s");
+  // |rho / rho0 - 1| above this stops the run as a blow-up.
+  if (auto t = m.get("max_density_variation")) n.density_ratio_limit = number(*t, positive());
 }
 
 void Reader::read_materials(const Value& v, fsi::Scene& scene) const {

@@ -13,10 +13,15 @@
 namespace turbid::sph {
 namespace {
 
+// Below this many particles a loop runs on one thread: thread start-up and barriers would cost
+// more than the work (and much more on a loaded machine).
+constexpr std::int64_t kParallelThreshold = 4096;
+
 template <class F>
-void parallel_for(std::uint32_t n, const F& f) {
-#pragma omp parallel for schedule(dynamic, 256)
-  for (std::int64_t i = 0; i < std::int64_t(n); ++i) f(std::uint32_t(i));
+void parallel_for(std::uint32_t n_particles, const F& f) {
+  const std::int64_t n = n_particles;
+#pragma omp parallel for schedule(dynamic, 256) if (n >= kParallelThreshold)
+  for (std::int64_t i = 0; i < n; ++i) f(std::uint32_t(i));
 }
 
 class CpuBackend final : public Backend {
@@ -36,6 +41,7 @@ class CpuBackend final : public Backend {
     cell_count_ = 1;
     for (int k = 0; k < d; ++k) {
       origin_[k] = domain.min[k];
+      domain_max_[k] = domain.max[k];
       cells_[k] = std::max(1, int(std::ceil((domain.max[k] - domain.min[k]) / cell)));
       cell_count_ *= std::size_t(cells_[k]);
     }
@@ -147,6 +153,7 @@ class CpuBackend final : public Backend {
 
   double spacing_estimate() const {
     // Volume per particle of the initial lattice, from the first particle's mass and density.
+    if (store_->size() == 0) return params_.smoothing_length;
     const double m = store_->data<Real>(ids_.mass)[0];
     const double rho = store_->data<Real>(ids_.density)[0];
     return std::pow(m / rho, 1.0 / params_.dimensions);
@@ -159,9 +166,15 @@ class CpuBackend final : public Backend {
     const Vec<D>* x = store_->data<Vec<D>>(ids_.position);
     const std::uint32_t outside = std::uint32_t(cell_count_);
     keys_.resize(n);
+    // The grid is a whole number of cells and may reach past the domain's upper faces; those
+    // particles are outside too.
+    Real upper[D];
+    for (int k = 0; k < D; ++k) upper[k] = Real(domain_max_[k]);
     parallel_for(n, [&](std::uint32_t i) {
       int c[D] = {};
-      keys_[i] = g.cell_of(x[i], c) ? g.linear(c) : outside;
+      bool inside = g.cell_of(x[i], c);
+      for (int k = 0; k < D; ++k) inside = inside && x[i][k] <= upper[k];
+      keys_[i] = inside ? g.linear(c) : outside;
     });
     // Stable counting sort: particles keep their relative order inside a cell, so the result is
     // the same on every run and thread count.
@@ -250,7 +263,7 @@ class CpuBackend final : public Backend {
     const ParticleView<D> P = view<D>();
     double v2 = 0, a2 = 0;
     const std::int64_t n = P.count;
-#pragma omp parallel for reduction(max : v2, a2) schedule(static)
+#pragma omp parallel for reduction(max : v2, a2) schedule(static) if (n >= kParallelThreshold)
     for (std::int64_t i = 0; i < n; ++i) {
       if (P.kind[i] != std::uint8_t(Kind::fluid)) continue;
       v2 = std::max(v2, double(norm2(P.velocity[i])));
@@ -265,7 +278,7 @@ class CpuBackend final : public Backend {
     const std::uint32_t* id = store_->data<std::uint32_t>(ids_.id);
     const std::int64_t n = P.count;
     std::int64_t first = n;
-#pragma omp parallel for reduction(min : first) schedule(static)
+#pragma omp parallel for reduction(min : first) schedule(static) if (n >= kParallelThreshold)
     for (std::int64_t i = 0; i < n; ++i) {
       if (!healthy<D>(P, std::uint32_t(i), limit)) first = std::min(first, i);
     }
@@ -301,7 +314,7 @@ class CpuBackend final : public Backend {
     const Real h = params_.smoothing_length;
     std::size_t total = 0;
     const std::int64_t n = P.count;
-#pragma omp parallel for reduction(+ : total) schedule(dynamic, 256)
+#pragma omp parallel for reduction(+ : total) schedule(dynamic, 256) if (n >= kParallelThreshold)
     for (std::int64_t i = 0; i < n; ++i) {
       int c[D] = {};
       G.cell_of(P.position[i], c);
@@ -320,6 +333,7 @@ class CpuBackend final : public Backend {
   FieldIds ids_;
   PhysicsParams params_;
   double origin_[3] = {0, 0, 0};
+  double domain_max_[3] = {0, 0, 0};
   int cells_[3] = {1, 1, 1};
   double inv_cell_ = 1;
   std::size_t cell_count_ = 1;

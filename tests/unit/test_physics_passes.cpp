@@ -1,0 +1,472 @@
+// Physics passes (sph/passes.hpp) run by the CPU backend on a small 2D lattice (30 x 30) built by
+// the Simulation from a Scene made in code (no walls; no gravity unless stated):
+//  (a) a fluid at rest with uniform density: zero continuity rate (exact) and zero acceleration
+//      (exact without background pressure; round-off with one, by lattice symmetry);
+//  (b) momentum conservation sum_i m_i a_i = 0 for random velocities and densities, artificial and
+//      laminar viscosity (pairwise antisymmetric forces, physics.md C3/C10);
+//  (c) continuity under uniform compression v = -k x: D rho/Dt = -rho div v = rho k D;
+//  (d) hydrostatic balance, (e) density diffusion in a hydrostatic column, (f) laminar viscosity
+//      of a parabolic profile, (g) bitwise independence of the thread count.
+// Lattice sums in double over the same float kernel values serve as brute-force references; the
+// analytic references hold within the lattice quadrature error measured in test_kernels.cpp.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <random>
+#include <string>
+
+#include "fsi/scene.hpp"
+#include "fsi/simulation.hpp"
+#include "sph/kernels.hpp"
+#include "sph/vec.hpp"
+
+namespace {
+
+using namespace turbid;
+using sph::Real;
+using sph::Vec;
+
+constexpr double kDx = 0.01;   // particle spacing [m]
+constexpr double kSide = 0.3;  // square block of 30 x 30 particles
+constexpr double kRho0 = 1000.0;
+
+struct SceneOptions {
+  double smoothing_ratio = 1.3;
+  sph::KernelKind kernel = sph::KernelKind::wendland_c2;
+  fsi::DiffusionKind diffusion = fsi::DiffusionKind::fourtakas;
+  fsi::ViscosityKind viscosity = fsi::ViscosityKind::artificial;
+  double artificial_viscosity = 0.05;
+  double dynamic_viscosity = 1e-3;
+  double background_pressure = 0.0;
+  double gravity = 0.0;  // [m/s^2] along -y
+};
+
+fsi::Scene make_scene(const SceneOptions& o) {
+  fsi::Scene s;
+  s.name = "unit_block";
+  s.dimensions = 2;
+  s.particle_spacing = kDx;
+  s.smoothing_ratio = o.smoothing_ratio;
+  s.gravity = {0, -o.gravity, 0};
+  s.numerics.kernel = o.kernel;
+  s.numerics.diffusion = o.diffusion;
+  s.numerics.viscosity = o.viscosity;
+  s.numerics.artificial_viscosity = o.artificial_viscosity;
+  fsi::MaterialSpec water;
+  water.name = "water";
+  water.density = kRho0;
+  water.viscosity = o.dynamic_viscosity;
+  water.sound_speed = 20.0;
+  water.gamma = 7.0;
+  water.background_pressure = o.background_pressure;
+  s.materials.push_back(water);
+  fsi::FluidBlock block;
+  block.material = "water";
+  block.box.min = {0, 0, 0};
+  block.box.max = {kSide, kSide, 0};
+  s.fluids.push_back(block);
+  return s;
+}
+
+// One thread: the passes are gathers, so results do not depend on the thread count (checked by
+// ThreadCountDoesNotChangeBits); one thread keeps each test fast on a loaded machine.
+fsi::RunOptions cpu(int threads = 1) {
+  fsi::RunOptions r;
+  r.backend = "cpu";
+  r.threads = threads;
+  return r;
+}
+
+struct Fields {
+  Vec<2>* x;
+  Vec<2>* v;
+  Vec<2>* a;
+  Real* rho;
+  Real* drho;
+  Real* m;
+  std::size_t n;
+};
+
+Fields fields(fsi::Simulation& sim) {
+  auto& s = sim.store();
+  const auto& id = sim.fields();
+  return {s.data<Vec<2>>(id.position), s.data<Vec<2>>(id.velocity), s.data<Vec<2>>(id.acceleration),
+          s.data<Real>(id.density),    s.data<Real>(id.density_rate), s.data<Real>(id.mass),
+          s.size()};
+}
+
+// Full kernel support inside the block: every lattice point within 2h exists.
+bool interior(const Vec<2>& x, double h) {
+  for (int k = 0; k < 2; ++k)
+    if (double(x[k]) - 2.0 * h < 0.0 || double(x[k]) + 2.0 * h > kSide) return false;
+  return true;
+}
+
+// (1/r) dW/dr of the scene's 2D kernel, evaluated in float like the engine.
+double kernel_f(sph::KernelKind kind, double r, double h) {
+  return kind == sph::KernelKind::wendland_c2 ? sph::WendlandC2<2>::f(Real(r), Real(h))
+                                              : sph::CubicSpline<2>::f(Real(r), Real(h));
+}
+
+// sum_j V_j |F_ij| r_ij over a full lattice support [1/m]: the size of one side of the
+// pressure sum per unit of 2 p / rho, the scale against which round-off is judged.
+double lattice_abs_gradient(double h, sph::KernelKind kind) {
+  const int n = int(std::ceil(2.0 * h / kDx)) + 1;
+  double s = 0;
+  for (int a = -n; a <= n; ++a)
+    for (int b = -n; b <= n; ++b) {
+      const double r = std::hypot(a * kDx, b * kDx);
+      if (r == 0) continue;
+      const double F = kernel_f(kind, r, h);
+      s += kDx * kDx * std::abs(F) * r;
+    }
+  return s;
+}
+
+// tr(sum_j (x_j - x_i) (x) grad_i W_ij V_j) = sum_j -F r^2 V_j over a full lattice support: the
+// discrete divergence operator's factor, D up to the lattice quadrature error.
+double lattice_trace(double h, sph::KernelKind kind) {
+  const int n = int(std::ceil(2.0 * h / kDx)) + 1;
+  double s = 0;
+  for (int a = -n; a <= n; ++a)
+    for (int b = -n; b <= n; ++b) {
+      const double r = std::hypot(a * kDx, b * kDx);
+      if (r == 0) continue;
+      const double F = kernel_f(kind, r, h);
+      s += -F * r * r * kDx * kDx;
+    }
+  return s;
+}
+
+std::string label(const SceneOptions& o) {
+  return std::string(o.kernel == sph::KernelKind::wendland_c2 ? "wendland" : "cubic") +
+         " h/dx=" + std::to_string(o.smoothing_ratio) + " diffusion=" + std::to_string(int(o.diffusion)) +
+         " viscosity=" + std::to_string(int(o.viscosity)) + " p_b=" + std::to_string(o.background_pressure);
+}
+
+// ---------------------------------------------------------------------------------------------
+// (a) Fluid at rest
+
+TEST(PhysicsPasses, RestStateHasZeroRatesForEveryDiffusion) {
+  for (auto diff : {fsi::DiffusionKind::none, fsi::DiffusionKind::molteni, fsi::DiffusionKind::antuono,
+                    fsi::DiffusionKind::fourtakas}) {
+    SceneOptions o;
+    o.diffusion = diff;
+    SCOPED_TRACE(label(o));
+    fsi::Simulation sim(make_scene(o), cpu());
+    sim.start();
+    sim.backend().compute_density_rate();
+    const Fields f = fields(sim);
+    ASSERT_EQ(f.n, 900u);
+    std::size_t inner = 0;
+    for (std::size_t i = 0; i < f.n; ++i) {
+      ASSERT_EQ(f.rho[i], Real(kRho0)) << "uniform initial density without gravity";
+      // Exact: v_ij = 0 and rho_j - rho_i = 0 make every continuity and diffusion term exactly 0
+      // (at interior and at free-surface particles alike).
+      EXPECT_EQ(f.drho[i], Real(0)) << "continuity rate at rest, particle " << i;
+      // Exact: p = B((rho0/rho0)^7 - 1) + 0 = 0 for every particle, so no force at all.
+      EXPECT_EQ(f.a[i][0], Real(0)) << i;
+      EXPECT_EQ(f.a[i][1], Real(0)) << i;
+      inner += interior(f.x[i], sim.params().smoothing_length);
+    }
+    EXPECT_GE(inner, 500u) << "test setup: interior particles present";
+  }
+}
+
+TEST(PhysicsPasses, RestStateWithBackgroundPressureIsBalancedInside) {
+  for (auto kernel : {sph::KernelKind::wendland_c2, sph::KernelKind::cubic_spline}) {
+    SceneOptions o;
+    o.kernel = kernel;
+    o.background_pressure = 1000.0;  // every particle has p = p_b > 0
+    SCOPED_TRACE(label(o));
+    fsi::Simulation sim(make_scene(o), cpu());
+    sim.start();
+    sim.backend().compute_density_rate();
+    const Fields f = fields(sim);
+    const double h = sim.params().smoothing_length;
+    // Scale of one side of the pressure sum: (2 p_b / rho0) sum_j V_j |F| r (~300 m/s^2 here).
+    const double scale = 2.0 * o.background_pressure / kRho0 * lattice_abs_gradient(h, kernel);
+    double px = 0, py = 0, abs_sum = 0, worst = 0;
+    for (std::size_t i = 0; i < f.n; ++i) {
+      EXPECT_EQ(f.drho[i], Real(0)) << "continuity rate at rest is exactly zero, particle " << i;
+      px += double(f.m[i]) * f.a[i][0];
+      py += double(f.m[i]) * f.a[i][1];
+      abs_sum += double(f.m[i]) * std::hypot(double(f.a[i][0]), double(f.a[i][1]));
+      if (interior(f.x[i], h)) worst = std::max(worst, std::hypot(double(f.a[i][0]), double(f.a[i][1])));
+    }
+    // Reference: lattice symmetry, the interior pressure forces cancel pair by pair. What is left
+    // is the rounding of float positions (|x| <= 0.3 m, eps |x| / r <= 2e-6 per pair), summed
+    // over ~20 pairs: below 1e-4 of the one-sided sum.
+    EXPECT_LT(worst, 1e-4 * scale) << "largest interior acceleration vs one-sided pressure sum " << scale;
+    // Free-surface particles are pushed outwards by p_b, but the total momentum change is zero
+    // (antisymmetric pair forces; float accumulation, rel 1e-6).
+    ASSERT_GT(abs_sum, 0.0);
+    EXPECT_LT(std::hypot(px, py), 1e-6 * abs_sum) << "sum m a vs sum m |a|";
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// (b) Momentum conservation with random velocities (and densities)
+
+void check_momentum(const SceneOptions& o, bool random_density) {
+  SCOPED_TRACE(label(o) + (random_density ? " random density" : " uniform density"));
+  fsi::Simulation sim(make_scene(o), cpu());
+  sim.start();
+  Fields f = fields(sim);
+  std::mt19937 rng(31337u);
+  auto u = [&] { return double(rng() >> 8) * (1.0 / 16777216.0) - 0.5; };  // [-0.5, 0.5)
+  for (std::size_t i = 0; i < f.n; ++i) {
+    f.v[i][0] = Real(2.0 * u());  // |v| ~ 1 m/s (a tenth of c0 = 20 m/s)
+    f.v[i][1] = Real(2.0 * u());
+    // Masses stay rho0 dx^2; a density change of +-0.5% gives pressures of +-0.035 B.
+    if (random_density) f.rho[i] = Real(kRho0 * (1.0 + 0.01 * u()));
+  }
+  sim.backend().sync_from_host();
+  sim.backend().compute_forces();
+  f = fields(sim);
+  double px = 0, py = 0, abs_sum = 0;
+  for (std::size_t i = 0; i < f.n; ++i) {
+    px += double(f.m[i]) * f.a[i][0];
+    py += double(f.m[i]) * f.a[i][1];
+    abs_sum += double(f.m[i]) * std::hypot(double(f.a[i][0]), double(f.a[i][1]));
+  }
+  ASSERT_GT(abs_sum, 0.0) << "test setup: forces act";
+  // Reference: Newton's third law. Every pair term (pressure, artificial or laminar viscosity)
+  // is antisymmetric in i, j, so sum_i m_i a_i = 0; the residual is float accumulation of each
+  // particle's sum (rel ~1e-7 per particle, partly cancelling): rel 1e-6 of sum m |a|.
+  EXPECT_LT(std::hypot(px, py), 1e-6 * abs_sum) << "|sum m a| = " << std::hypot(px, py) << ", sum m|a| = " << abs_sum;
+}
+
+TEST(PhysicsPasses, MomentumConservedArtificialViscosity) {
+  SceneOptions o;
+  o.viscosity = fsi::ViscosityKind::artificial;
+  o.artificial_viscosity = 0.1;
+  check_momentum(o, false);  // viscosity alone (p = 0)
+  check_momentum(o, true);   // pressure and viscosity
+  o.kernel = sph::KernelKind::cubic_spline;
+  check_momentum(o, true);
+}
+
+TEST(PhysicsPasses, MomentumConservedLaminarViscosity) {
+  SceneOptions o;
+  o.viscosity = fsi::ViscosityKind::laminar;
+  o.dynamic_viscosity = 1.0;  // large enough that viscosity competes with pressure
+  check_momentum(o, false);
+  check_momentum(o, true);
+  o.smoothing_ratio = 2.0;
+  o.kernel = sph::KernelKind::cubic_spline;
+  check_momentum(o, true);
+}
+
+// ---------------------------------------------------------------------------------------------
+// (c) Uniform compression
+
+void check_compression(const SceneOptions& o, double analytic_tolerance) {
+  SCOPED_TRACE(label(o));
+  fsi::Simulation sim(make_scene(o), cpu());
+  sim.start();
+  Fields f = fields(sim);
+  const double k = 2.0;  // compression rate [1/s]
+  const double c = 0.5 * kSide;
+  for (std::size_t i = 0; i < f.n; ++i)
+    for (int d = 0; d < 2; ++d) f.v[i][d] = Real(-k * (double(f.x[i][d]) - c));  // v = -k (x - x_c)
+  sim.backend().sync_from_host();
+  sim.backend().compute_density_rate();
+  f = fields(sim);
+  const double h = sim.params().smoothing_length;
+  const double expected = kRho0 * k * 2.0;  // -rho div v = rho k D, D = 2
+  const double discrete = kRho0 * k * lattice_trace(h, o.kernel);
+  std::size_t inner = 0;
+  for (std::size_t i = 0; i < f.n; ++i) {
+    if (!interior(f.x[i], h)) continue;
+    ++inner;
+    // Reference 1 (brute force): the SPH sum rho k sum_j -F r^2 V_j over the lattice in double;
+    // the pass must reproduce it up to float rounding of positions and velocities (~2e-6), rel 1e-4.
+    // Diffusion vanishes for a uniform density.
+    EXPECT_NEAR(f.drho[i], discrete, 1e-4 * discrete) << "particle at (" << f.x[i][0] << ", " << f.x[i][1] << ")";
+    // Reference 2 (analytic): -rho div v = rho k D, within the lattice consistency error of the
+    // kernel (test_kernels.cpp: 1% for h/dx = 1.7 and 2.0; 2.6% for Wendland at h/dx = 1.3).
+    EXPECT_NEAR(f.drho[i], expected, analytic_tolerance * expected)
+        << "particle at (" << f.x[i][0] << ", " << f.x[i][1] << ")";
+  }
+  EXPECT_GE(inner, 400u) << "test setup: interior particles present";
+}
+
+TEST(PhysicsPasses, ContinuityUnderUniformCompression) {
+  for (auto kernel : {sph::KernelKind::wendland_c2, sph::KernelKind::cubic_spline})
+    for (double ratio : {1.3, 1.7, 2.0})
+      for (auto diff : {fsi::DiffusionKind::none, fsi::DiffusionKind::fourtakas}) {
+        SceneOptions o;
+        o.kernel = kernel;
+        o.smoothing_ratio = ratio;
+        o.diffusion = diff;
+        // 1% as asked where the lattice allows it; at h/dx = 1.3 the discrete divergence of the
+        // lattice itself is off by -2.6% (Wendland) / +1.05% (cubic spline), hence 3%.
+        check_compression(o, ratio < 1.5 ? 0.03 : 0.01);
+      }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Beyond the required checks: signs and sizes of gravity, diffusion and laminar viscosity.
+
+// (d) A column at rest with the hydrostatic initial density (physics.md D8): the pressure gradient
+// balances gravity at interior particles. Reference: analytic balance -grad p / rho + g = 0. Two
+// known discrepancies bound the residual: the lattice consistency error of the discrete gradient
+// |1 - M_yy| (test_kernels.cpp: 2.6% at h/dx = 1.3, 0.09% at 2.0) and the initial state
+// p = rho0 g d (D8) against the balance dp/dd = rho g, off by rho/rho0 - 1 <= g H / c0^2 = 0.74%.
+TEST(PhysicsPasses, HydrostaticPressureBalancesGravity) {
+  const double g = 9.81;
+  for (auto kernel : {sph::KernelKind::wendland_c2, sph::KernelKind::cubic_spline})
+    for (double ratio : {1.3, 2.0}) {
+      SceneOptions o;
+      o.kernel = kernel;
+      o.smoothing_ratio = ratio;
+      o.gravity = g;
+      SCOPED_TRACE(label(o));
+      fsi::Simulation sim(make_scene(o), cpu());
+      sim.start();
+      const Fields f = fields(sim);
+      const double h = sim.params().smoothing_length;
+      const double tolerance = ratio < 1.5 ? 0.04 : 0.01;  // (2.6% or 0.09%) + 0.74%, rounded up
+      std::size_t inner = 0;
+      for (std::size_t i = 0; i < f.n; ++i) {
+        if (!interior(f.x[i], h)) continue;
+        ++inner;
+        EXPECT_LT(std::hypot(double(f.a[i][0]), double(f.a[i][1])), tolerance * g)
+            << "net acceleration at (" << f.x[i][0] << ", " << f.x[i][1] << ")";
+      }
+      EXPECT_GE(inner, 400u);
+    }
+}
+
+// (e) Density diffusion in the same hydrostatic column at rest (v = 0, so the density rate is the
+// diffusion term alone). References (physics.md C3, C4):
+//  - Molteni & Colagrossi is not zero in hydrostatics: at the free surface, where the support is
+//    cut, it diffuses density upwards (positive rate: the particles below are denser);
+//  - Antuono's renormalised term vanishes for a linear density profile; the Tait profile's
+//    curvature (rho'' r^2 / 2 vs rho' r: 1e-3) and float rounding of rho leave < 2e-3 of Molteni's;
+//  - Fourtakas subtracts the hydrostatic difference computed with rho0 and B, which differs from
+//    the local one by (gamma - 1) g d / c0^2 (4.4% at the bottom, d = 0.3 m, 0.07% in the top row);
+//    its prefactor delta 2h is twice Molteni's delta h: < 8.8% of Molteni's maximum everywhere and
+//    < 2e-3 of it in the top row. A wrong sign of rho^H would instead double the Molteni value.
+TEST(PhysicsPasses, DiffusionInHydrostaticColumn) {
+  double max_rate[4] = {}, top_rate[4] = {};
+  const double g = 9.81, c0 = 20.0, gamma = 7.0;
+  for (auto diff : {fsi::DiffusionKind::molteni, fsi::DiffusionKind::antuono, fsi::DiffusionKind::fourtakas}) {
+    SceneOptions o;
+    o.diffusion = diff;
+    o.gravity = g;
+    fsi::Simulation sim(make_scene(o), cpu());
+    sim.start();
+    sim.backend().compute_density_rate();
+    const Fields f = fields(sim);
+    const int d = int(diff);
+    for (std::size_t i = 0; i < f.n; ++i) {
+      max_rate[d] = std::max(max_rate[d], std::abs(double(f.drho[i])));
+      // the top row, away from the side edges
+      if (f.x[i][1] > kSide - kDx && f.x[i][0] > 0.1 && f.x[i][0] < 0.2 && std::abs(f.drho[i]) > std::abs(top_rate[d]))
+        top_rate[d] = f.drho[i];  // signed value of largest magnitude
+    }
+  }
+  const int mol = int(fsi::DiffusionKind::molteni), ant = int(fsi::DiffusionKind::antuono),
+            fou = int(fsi::DiffusionKind::fourtakas);
+  EXPECT_GT(top_rate[mol], 1.0) << "Molteni diffuses density upwards at the free surface [kg/m^3/s]";
+  EXPECT_LT(max_rate[ant], 2e-3 * max_rate[mol]) << "Antuono vanishes for the hydrostatic profile";
+  EXPECT_LT(max_rate[fou], 2.0 * (gamma - 1.0) * g * kSide / (c0 * c0) * max_rate[mol])
+      << "Fourtakas removes the hydrostatic part";
+  EXPECT_LT(std::abs(top_rate[fou]), 2e-3 * max_rate[mol]) << "Fourtakas in the top row";
+}
+
+// (f) Morris laminar viscosity of a parabolic shear flow v = (k (y - y_c)^2, 0) at interior
+// particles. References: (1) brute force: on the lattice the odd part of v_ij cancels and the sum
+// is 2 nu k sum_j V_j (-F) dy^2 r^2 / (r^2 + eta^2), evaluated here in double (rel 1e-3: float
+// rounding of v amplified by the cancellation of the odd part, ~1e-4); (2) analytic nu d2v/dy2 =
+// 2 nu k, within the lattice consistency error plus the eta^2 = 0.01 h^2 regularisation (~1.5%):
+// 4% at h/dx = 1.3, 2% at 2.0. a_y must vanish exactly (v_y = 0, no pressure).
+TEST(PhysicsPasses, LaminarViscosityGivesNuLaplacian) {
+  for (auto kernel : {sph::KernelKind::wendland_c2, sph::KernelKind::cubic_spline})
+    for (double ratio : {1.3, 2.0}) {
+      SceneOptions o;
+      o.kernel = kernel;
+      o.smoothing_ratio = ratio;
+      o.viscosity = fsi::ViscosityKind::laminar;
+      o.dynamic_viscosity = 1.0;
+      SCOPED_TRACE(label(o));
+      fsi::Simulation sim(make_scene(o), cpu());
+      sim.start();
+      Fields f = fields(sim);
+      const double k = 10.0, c = 0.5 * kSide;  // [1/(m s)], centre line [m]
+      for (std::size_t i = 0; i < f.n; ++i) {
+        const double y = double(f.x[i][1]) - c;
+        f.v[i][0] = Real(k * y * y);
+        f.v[i][1] = 0;
+      }
+      sim.backend().sync_from_host();
+      sim.backend().compute_forces();
+      f = fields(sim);
+      const double h = sim.params().smoothing_length;
+      const double nu = o.dynamic_viscosity / kRho0;
+      const double analytic = 2.0 * nu * k;
+      double lattice = 0;
+      const int n = int(std::ceil(2.0 * h / kDx)) + 1;
+      for (int a = -n; a <= n; ++a)
+        for (int b = -n; b <= n; ++b) {
+          const double r = std::hypot(a * kDx, b * kDx);
+          if (r == 0) continue;
+          const double F = kernel_f(kernel, r, h);
+          const double dy = b * kDx;
+          lattice += kDx * kDx * (-F) * dy * dy * r * r / (r * r + 0.01 * h * h);
+        }
+      const double discrete = 2.0 * nu * k * lattice;
+      const double tolerance = ratio < 1.5 ? 0.04 : 0.02;
+      std::size_t inner = 0;
+      for (std::size_t i = 0; i < f.n; ++i) {
+        if (!interior(f.x[i], h)) continue;
+        ++inner;
+        EXPECT_NEAR(f.a[i][0], discrete, 1e-3 * discrete) << "brute-force lattice sum, y = " << f.x[i][1];
+        EXPECT_NEAR(f.a[i][0], analytic, tolerance * analytic) << "nu d2v/dy2, y = " << f.x[i][1];
+        EXPECT_EQ(f.a[i][1], Real(0)) << "no force across the flow";
+      }
+      EXPECT_GE(inner, 400u);
+    }
+}
+
+// (g) Determinism (design.md: gather, not scatter): the same scene on 1 and 2 threads gives the
+// same bits for accelerations, density rates, positions and densities after a step with
+// gravity, random velocities, diffusion and viscosity. Reference: bitwise equality (memcmp).
+TEST(PhysicsPasses, ThreadCountDoesNotChangeBits) {
+  SceneOptions o;
+  o.gravity = 9.81;
+  o.diffusion = fsi::DiffusionKind::antuono;
+  o.viscosity = fsi::ViscosityKind::laminar;
+  o.dynamic_viscosity = 0.1;
+  auto run = [&](int threads) {
+    auto sim = std::make_unique<fsi::Simulation>(make_scene(o), cpu(threads));
+    sim->start();
+    Fields f = fields(*sim);
+    std::mt19937 rng(4242u);
+    for (std::size_t i = 0; i < f.n; ++i)
+      for (int d = 0; d < 2; ++d) f.v[i][d] = Real(0.2 * (double(rng() >> 8) / 16777216.0 - 0.5));
+    sim->backend().sync_from_host();
+    sim->backend().compute_forces();
+    sim->step();  // one full kick-drift-sort-kick step (few parallel regions: fast on a loaded machine)
+    sim->backend().compute_density_rate();
+    sim->sync_to_host();
+    return sim;
+  };
+  auto one = run(1), two = run(2);
+  ASSERT_EQ(one->store().size(), two->store().size());
+  const auto& ids = one->fields();
+  for (auto field : {ids.position, ids.velocity, ids.acceleration, ids.density, ids.density_rate, ids.pressure, ids.id}) {
+    const std::size_t bytes = one->store().size() * one->store().field_bytes(field);
+    EXPECT_EQ(std::memcmp(one->store().raw(field), two->store().raw(field), bytes), 0)
+        << "field " << one->store().desc(field).name << " differs between 1 and 2 threads";
+  }
+  EXPECT_EQ(one->time(), two->time());
+}
+
+}  // namespace
