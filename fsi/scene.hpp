@@ -101,7 +101,7 @@ struct Scene {
   std::string source_file;  // the YAML file, for messages; empty when built in code
   int dimensions = 2;
   double particle_spacing = 0.01;  // dx [m]
-  double smoothing_ratio = 1.3;    // h = smoothing_ratio * dx
+  double smoothing_ratio = 2.0;    // h = smoothing_ratio * dx; Wendland C2 needs h/dx near 2 on a lattice (docs/validation.md)
   double end_time = 1.0;           // [s]
   Vec3d gravity{0, -9.81, 0};      // [m/s^2]
   NumericsSpec numerics;

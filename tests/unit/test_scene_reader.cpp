@@ -268,14 +268,14 @@ TEST(SceneReader, GoodDamBreak2dParsesToTheWrittenValues) {
   EXPECT_DOUBLE_EQ(s.domain->max[1], 3.0);
 }
 
-// The 3D good scene gives only a few keys, so the defaults of the schema show: smoothing ratio 1.3,
+// The 3D good scene gives only a few keys, so the defaults of the schema show: smoothing ratio 2.0,
 // gravity -9.81 on z, material viscosity 1e-3 and gamma 7, Scene's numerics defaults.
 TEST(SceneReader, GoodTank3dUsesTheDefaults) {
   const turbid::fsi::Scene s = read_scene_file(kData + "/good_scenes/tank_3d.yaml");
   EXPECT_EQ(s.name, "tank_3d");
   EXPECT_EQ(s.dimensions, 3);
   EXPECT_DOUBLE_EQ(s.particle_spacing, 0.02);
-  EXPECT_DOUBLE_EQ(s.smoothing_ratio, 1.3);
+  EXPECT_DOUBLE_EQ(s.smoothing_ratio, 2.0);
   EXPECT_DOUBLE_EQ(s.end_time, 0.5);
   EXPECT_DOUBLE_EQ(s.gravity[0], 0.0);
   EXPECT_DOUBLE_EQ(s.gravity[1], 0.0);
