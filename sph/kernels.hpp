@@ -24,11 +24,17 @@ struct WendlandC2 {
     return norm(h) * a2 * a2 * (Real(2) * q + Real(1));
   }
   // (1/r) dW/dr = -5 alpha_d / h^2 (1 - q/2)^3
-  TURBID_HD static Real f(Real r, Real h) {
-    const Real q = r / h;
+  TURBID_HD static Real f(Real r, Real h) { return f_q(r / h, Real(1) / h); }
+  // The same from 1/h, without divisions: the form the pair loops use.
+  TURBID_HD static Real f_inv(Real r, Real inv_h) { return f_q(r * inv_h, inv_h); }
+  TURBID_HD static Real f_q(Real q, Real inv_h) {
     if (q >= Real(2)) return Real(0);
     const Real a = Real(1) - Real(0.5) * q;
-    return Real(-5) * norm(h) / (h * h) * a * a * a;
+    return Real(-5) * norm_inv(inv_h) * inv_h * inv_h * a * a * a;
+  }
+  TURBID_HD static Real norm_inv(Real inv_h) {
+    if constexpr (D == 2) return Real(7) / (Real(4) * kPi) * inv_h * inv_h;
+    else return Real(21) / (Real(16) * kPi) * inv_h * inv_h * inv_h;
   }
 };
 
@@ -46,13 +52,20 @@ struct CubicSpline {
     const Real b = Real(2) - q;
     return norm(h) * Real(0.25) * b * b * b;
   }
-  TURBID_HD static Real f(Real r, Real h) {
-    const Real q = r / h;
+  TURBID_HD static Real f(Real r, Real h) { return f_q(r / h, Real(1) / h); }
+  // The same from 1/h: the form the pair loops use (one division, for q >= 1).
+  TURBID_HD static Real f_inv(Real r, Real inv_h) { return f_q(r * inv_h, inv_h); }
+  TURBID_HD static Real f_q(Real q, Real inv_h) {
     if (q >= Real(2)) return Real(0);
+    const Real c = norm_inv(inv_h) * inv_h * inv_h;
     // dW/dq / (q h^2): (-3 + 2.25 q) for q < 1, -0.75 (2 - q)^2 / q for 1 <= q < 2
-    if (q < Real(1)) return norm(h) / (h * h) * (Real(-3) + Real(2.25) * q);
+    if (q < Real(1)) return c * (Real(-3) + Real(2.25) * q);
     const Real b = Real(2) - q;
-    return norm(h) / (h * h) * Real(-0.75) * b * b / q;
+    return c * Real(-0.75) * b * b / q;
+  }
+  TURBID_HD static Real norm_inv(Real inv_h) {
+    if constexpr (D == 2) return Real(10) / (Real(7) * kPi) * inv_h * inv_h;
+    else return Real(1) / kPi * inv_h * inv_h * inv_h;
   }
 };
 

@@ -16,6 +16,9 @@ struct GridView {
   Real inv_cell;      // 1 / cell size [1/m]
   int cells[D];       // number of cells per axis
   const std::uint32_t* cell_start;  // size cell_count + 1: particles of cell c are [start[c], start[c+1])
+  // Optional (CPU): fluid particles in cells [0, c) for each c (size cell_count + 1), so that a wall
+  // particle can see at once that no fluid is near it.
+  const std::uint32_t* fluid_before = nullptr;
 
   TURBID_HD int cell_count() const {
     int n = 1;
@@ -36,16 +39,28 @@ struct GridView {
     for (int k = D - 2; k >= 0; --k) idx = idx * std::uint32_t(cells[k]) + std::uint32_t(c[k]);
     return idx;
   }
+  // True if a fluid particle may be in the cells around cell c (always true without fluid_before).
+  TURBID_HD bool fluid_near(const int* c) const {
+    if (!fluid_before) return true;
+    bool any = false;
+    for_each_cell_range(c, [&](std::uint32_t c0, std::uint32_t c1) { any = any || fluid_before[c1] > fluid_before[c0]; });
+    return any;
+  }
   // Calls f(begin, end) for every contiguous range of particles in the cells around cell c.
   template <class F>
   TURBID_HD void for_each_neighbour_range(const int* c, F&& f) const {
+    for_each_cell_range(c, [&](std::uint32_t c0, std::uint32_t c1) { f(cell_start[c0], cell_start[c1]); });
+  }
+  // Calls f(first cell, last cell + 1) for every row of 3 cells around cell c (x fastest).
+  template <class F>
+  TURBID_HD void for_each_cell_range(const int* c, F&& f) const {
     const int x0 = c[0] > 0 ? c[0] - 1 : 0;
     const int x1 = c[0] + 1 < cells[0] ? c[0] + 1 : cells[0] - 1;
     if constexpr (D == 2) {
       for (int y = c[1] - 1; y <= c[1] + 1; ++y) {
         if (y < 0 || y >= cells[1]) continue;
         const std::uint32_t row = std::uint32_t(y) * std::uint32_t(cells[0]);
-        f(cell_start[row + std::uint32_t(x0)], cell_start[row + std::uint32_t(x1) + 1]);
+        f(row + std::uint32_t(x0), row + std::uint32_t(x1) + 1);
       }
     } else {
       for (int z = c[2] - 1; z <= c[2] + 1; ++z) {
@@ -53,7 +68,7 @@ struct GridView {
         for (int y = c[1] - 1; y <= c[1] + 1; ++y) {
           if (y < 0 || y >= cells[1]) continue;
           const std::uint32_t row = (std::uint32_t(z) * std::uint32_t(cells[1]) + std::uint32_t(y)) * std::uint32_t(cells[0]);
-          f(cell_start[row + std::uint32_t(x0)], cell_start[row + std::uint32_t(x1) + 1]);
+          f(row + std::uint32_t(x0), row + std::uint32_t(x1) + 1);
         }
       }
     }

@@ -91,9 +91,15 @@ TURBID_HD inline void for_each_neighbour(const ParticleView<D>& P, const GridVie
           }
           r2buf[k] = r2;
         }
+        // Branch-free compaction of the indices inside the support, then the pairs.
+        std::uint32_t hit[kChunk];
+        std::uint32_t m = 0;
         for (std::uint32_t k = 0; k < len; ++k) {
-          const std::uint32_t j = b0 + k;
-          if (r2buf[k] >= support2 || j == i) continue;
+          hit[m] = b0 + k;
+          m += (r2buf[k] < support2 && b0 + k != i) ? 1u : 0u;
+        }
+        for (std::uint32_t k = 0; k < m; ++k) {
+          const std::uint32_t j = hit[k];
           if (out) {
             if (n < L.stride) out[n] = j;
             ++n;
@@ -158,7 +164,7 @@ struct DensityGradientPass {
         if (P.kind[j] != std::uint8_t(Kind::fluid) || P.material[j] != mat_i || r2 == Real(0)) return;
         const Real h = pair_h<D, K>(P, prm, UniformH, h_i, j);
         if (!UniformH && r2 >= Real(4) * h * h) return;
-        const Real F = K::f(std::sqrt(r2), h);
+        const Real F = K::f_inv(std::sqrt(r2), Real(1) / h);
         const Real vol = P.mass[j] / P.density[j];
         for (int a = 0; a < D; ++a) {
           g[a] += (P.density[j] - rho_i) * F * rij[a] * vol;
@@ -221,12 +227,21 @@ struct ContinuityPass {
     const Real hydro_k = Mi.eos.rest_density / Mi.eos.stiffness;
 
     Real drho = 0;
+    if (!fluid_i) {
+      // A wall particle changes density only through fluid neighbours; most walls have none near.
+      int c[D] = {};
+      G.cell_of(xi, c);
+      if (!G.fluid_near(c)) {
+        P.density_rate[i] = Real(0);
+        return;
+      }
+    }
     for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
         const Real h = pair_h<D, K>(P, prm, UniformH, h_i, j);
         if (!UniformH && r2 >= Real(4) * h * h) return;
         const bool fluid_j = P.kind[j] == std::uint8_t(Kind::fluid);
         if (!fluid_i && !fluid_j) return;
-        const Real F = K::f(std::sqrt(r2), h);
+        const Real F = K::f_inv(std::sqrt(r2), Real(1) / h);
         const Real rho_j = P.density[j];
         const Real vol_j = P.mass[j] / rho_j;
         drho += pair::continuity(rho_i, vol_j, dot(vi - P.velocity[j], rij), F);
@@ -277,7 +292,7 @@ struct MomentumPass {
     for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
         const Real h = pair_h<D, K>(P, prm, UniformH, h_i, j);
         if (!UniformH && r2 >= Real(4) * h * h) return;
-        const Real F = K::f(std::sqrt(r2), h);
+        const Real F = K::f_inv(std::sqrt(r2), Real(1) / h);
         const Real rho_j = P.density[j];
         const Real m_j = P.mass[j];
         const std::uint8_t mat_j = P.kind[j] == std::uint8_t(Kind::fluid) ? P.material[j] : std::uint8_t(prm.wall_material);

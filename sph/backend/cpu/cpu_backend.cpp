@@ -125,6 +125,7 @@ class CpuBackend final : public Backend {
     }
     g.inv_cell = Real(inv_cell_);
     g.cell_start = cell_start_.data();
+    g.fluid_before = fluid_before_.empty() ? nullptr : fluid_before_.data();
     return g;
   }
 
@@ -192,6 +193,12 @@ class CpuBackend final : public Backend {
     store_->permute(order_.data());
     const std::uint32_t kept = cell_start_[cell_count_];
     store_->resize(kept);
+    // Fluid particles before each cell, for walls that look for fluid around them.
+    fluid_before_.assign(cell_count_ + 1, 0);
+    const std::uint8_t* kind = store_->data<std::uint8_t>(ids_.kind);
+    for (std::uint32_t r = 0; r < kept; ++r)
+      if (kind[r] == std::uint8_t(Kind::fluid)) ++fluid_before_[keys_[order_[r]] + 1];
+    for (std::size_t c = 0; c < cell_count_; ++c) fluid_before_[c + 1] += fluid_before_[c];
     // Coordinate arrays for the vectorised distance checks of the passes that follow.
     soa_stride_ = kept;
     soa_.resize(std::size_t(D) * kept);
@@ -338,7 +345,7 @@ class CpuBackend final : public Backend {
   double inv_cell_ = 1;
   std::size_t cell_count_ = 1;
   std::vector<std::uint32_t> cell_start_, cursor_, keys_, order_;
-  std::vector<std::uint32_t> list_entries_, list_count_;
+  std::vector<std::uint32_t> list_entries_, list_count_, fluid_before_;
   std::uint32_t list_stride_ = 0;
   bool list_valid_ = false;
   std::vector<Real> soa_;
