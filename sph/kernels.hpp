@@ -27,10 +27,11 @@ struct WendlandC2 {
   TURBID_HD static Real f(Real r, Real h) { return f_q(r / h, Real(1) / h); }
   // The same from 1/h, without divisions: the form the pair loops use.
   TURBID_HD static Real f_inv(Real r, Real inv_h) { return f_q(r * inv_h, inv_h); }
+  // Written without branches (selects only), so that pair loops can be vectorised.
   TURBID_HD static Real f_q(Real q, Real inv_h) {
-    if (q >= Real(2)) return Real(0);
     const Real a = Real(1) - Real(0.5) * q;
-    return Real(-5) * norm_inv(inv_h) * inv_h * inv_h * a * a * a;
+    const Real v = Real(-5) * norm_inv(inv_h) * inv_h * inv_h * a * a * a;
+    return q >= Real(2) ? Real(0) : v;
   }
   TURBID_HD static Real norm_inv(Real inv_h) {
     if constexpr (D == 2) return Real(7) / (Real(4) * kPi) * inv_h * inv_h;
@@ -55,13 +56,16 @@ struct CubicSpline {
   TURBID_HD static Real f(Real r, Real h) { return f_q(r / h, Real(1) / h); }
   // The same from 1/h: the form the pair loops use (one division, for q >= 1).
   TURBID_HD static Real f_inv(Real r, Real inv_h) { return f_q(r * inv_h, inv_h); }
+  // Written without branches (both pieces evaluated, then selected), so that pair loops can be
+  // vectorised.
   TURBID_HD static Real f_q(Real q, Real inv_h) {
-    if (q >= Real(2)) return Real(0);
     const Real c = norm_inv(inv_h) * inv_h * inv_h;
     // dW/dq / (q h^2): (-3 + 2.25 q) for q < 1, -0.75 (2 - q)^2 / q for 1 <= q < 2
-    if (q < Real(1)) return c * (Real(-3) + Real(2.25) * q);
+    const Real inner = Real(-3) + Real(2.25) * q;
     const Real b = Real(2) - q;
-    return c * Real(-0.75) * b * b / q;
+    const Real outer = Real(-0.75) * b * b / q;
+    const Real v = c * (q < Real(1) ? inner : outer);
+    return q >= Real(2) ? Real(0) : v;
   }
   TURBID_HD static Real norm_inv(Real inv_h) {
     if constexpr (D == 2) return Real(10) / (Real(7) * kPi) * inv_h * inv_h;

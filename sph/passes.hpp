@@ -289,6 +289,15 @@ struct MomentumPass {
     const Real h_i = UniformH ? prm.smoothing_length : P.smoothing_length[i];
     const MaterialParams& Mi = prm.materials[P.material[i]];
     const bool artificial = prm.viscosity == Viscosity::artificial;
+#if !defined(__CUDA_ARCH__)
+    if constexpr (UniformH) {
+      if (artificial && lanes(i, xi, vi, rho_i, p_i, Mi, acc)) {
+        for (int k = 0; k < D; ++k) acc[k] += prm.gravity[k];
+        P.acceleration[i] = acc;
+        return;
+      }
+    }
+#endif
     for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
         const Real h = pair_h<D, K>(P, prm, UniformH, h_i, j);
         if (!UniformH && r2 >= Real(4) * h * h) return;
@@ -311,6 +320,59 @@ struct MomentumPass {
     });
     for (int k = 0; k < D; ++k) acc[k] += prm.gravity[k];
     P.acceleration[i] = acc;
+  }
+
+  // CPU: the same sums (uniform h, artificial viscosity) in W independent lanes, so that the
+  // compiler can evaluate W pairs at once with vector instructions; the lanes are added in a fixed
+  // order, so results stay deterministic. Returns false (nothing done) if the neighbours do not fit.
+  static constexpr int W = 8;
+  static constexpr std::uint32_t kMaxNeighbours = 1024;
+  bool lanes(std::uint32_t i, const Vec<D>& xi, const Vec<D>& vi, Real rho_i, Real p_i, const MaterialParams& Mi,
+             Vec<D>& acc) const {
+    std::uint32_t nb[kMaxNeighbours + W];
+    std::uint32_t m = 0;
+    bool fits = true;
+    for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>&, Real) {
+      if (m < kMaxNeighbours) nb[m++] = j;
+      else fits = false;
+    });
+    if (!fits) return false;
+    for (std::uint32_t k = m; k < m + W; ++k) nb[k] = i;  // padding lanes: j = i, masked below
+    const Real h = prm.smoothing_length;
+    const Real inv_h = Real(1) / h;
+    const Real eta2 = kEta2Factor * h * h;
+    const Real ah = prm.artificial_viscosity * h;
+    const Real c_i = Mi.sound_speed;
+    Real sum[D][W] = {};
+    for (std::uint32_t k0 = 0; k0 < m; k0 += W) {
+      for (int l = 0; l < W; ++l) {
+        const std::uint32_t j = nb[k0 + std::uint32_t(l)];
+        const Real valid = (k0 + std::uint32_t(l) < m) ? Real(1) : Real(0);
+        Real r[D];
+        Real r2 = 0, vr = 0;
+        for (int a = 0; a < D; ++a) {
+          r[a] = xi[a] - P.position[j][a];
+          r2 += r[a] * r[a];
+          vr += (vi[a] - P.velocity[j][a]) * r[a];
+        }
+        const Real rs = valid > Real(0) ? r2 : h * h;  // padding: a harmless distance (q = 1)
+        const Real F = K::f_inv(std::sqrt(rs), inv_h);
+        const Real rho_j = P.density[j];
+        const Real m_j = P.mass[j] * valid;
+        const int mat_j = P.kind[j] == std::uint8_t(Kind::fluid) ? int(P.material[j]) : prm.wall_material;
+        const Real c_mean = Real(0.5) * (c_i + prm.materials[mat_j].sound_speed);
+        const Real press = -(p_i + P.pressure[j]) / (rho_i * rho_j);
+        const Real visc = vr < Real(0) ? ah * c_mean * vr / ((rs + eta2) * Real(0.5) * (rho_i + rho_j)) : Real(0);
+        const Real s = m_j * F * (press + visc);
+        for (int a = 0; a < D; ++a) sum[a][l] += s * r[a];
+      }
+    }
+    for (int a = 0; a < D; ++a) {
+      Real t = 0;
+      for (int l = 0; l < W; ++l) t += sum[a][l];
+      acc[a] = t;
+    }
+    return true;
   }
 };
 
