@@ -97,7 +97,8 @@ int main(int argc, char** argv) {
                 report.at("simulated_time").get<double>(), report.at("wall_seconds").get<double>(),
                 report.at("particle_steps_per_second").get<double>(),
                 static_cast<unsigned long long>(report.at("removed_particles").get<std::uint64_t>()));
-    std::printf("results in %s: particles.pvd (open in ParaView), probes.csv, run.json\n", dir.c_str());
+    const bool vtk = std::filesystem::exists(std::filesystem::path(dir) / "particles.pvd");
+    std::printf("results in %s: %sprobes.csv, run.json\n", dir.c_str(), vtk ? "particles.pvd (open in ParaView), " : "");
     return 0;
   } catch (const turbid::tools::SceneError& e) {
     std::fprintf(stderr, "%s\n", e.what());

@@ -1,0 +1,253 @@
+"""Error metrics of the validation scenes, shared by tools/convergence and docs/validation.md.
+
+Each metric reads a finished `turbid run` directory (probes.csv, run.json) and compares it with its
+reference. The C++ validation tests (tests/validation/) compute the same numbers; keep the two in
+step when a definition changes.
+
+  dam_break_2d         RMS of the relative surge-front error (Z_sim - Z_exp) / Z_exp over the
+                       Martin & Moyce (1952) points with T <= 3 (scenes/reference/...csv).
+  hydrostatic_tank_2d  largest relative error |p - rho0 g (H - y)| / (rho0 g (H - y)) of the
+                       pressure probes at the end of the run; also the largest max_speed over
+                       sqrt(g H).
+
+Run as a script, it plots the dam-break front of one or more runs against the experiment:
+
+  /usr/bin/python3 tools/validation_metrics.py plot-dam-break RUN_DIR [RUN_DIR...] --png FILE
+"""
+
+import argparse
+import json
+import math
+import os
+import sys
+
+REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+REFERENCE_DIR = os.path.join(REPO_ROOT, "scenes", "reference")
+
+GRAVITY = 9.81  # m/s^2, as in the scenes
+
+# Martin & Moyce (1952), n^2 = 2: column width a, height 2a; T = t sqrt(2 g / a), Z = x_front / a.
+DAM_BREAK_COLUMN_WIDTH = 0.05715  # m (2.25 in)
+DAM_BREAK_T_MAX = 3.0             # compare for T <= 3
+DAM_BREAK_REFERENCE = os.path.join(REFERENCE_DIR, "martin_moyce1952_surge_front_n2eq2_Ocellaris.csv")
+
+# Hydrostatic tank (scenes/hydrostatic_tank_2d.yaml).
+HYDROSTATIC_DEPTH = 1.0      # H [m]
+HYDROSTATIC_DENSITY = 1000.0  # rho0 [kg/m^3]
+HYDROSTATIC_PROBES = {"p_mid": 0.5, "p_bottom": 0.1}  # probe name -> height y [m]
+
+
+def read_csv(path):
+    """Reads a numeric CSV with a header line; lines starting with '#' are skipped.
+    Returns {column name: list of floats}."""
+    columns = None
+    names = []
+    with open(path) as f:
+        for line in f:
+            line = line.strip()
+            if not line or line.startswith("#"):
+                continue
+            cells = [c.strip() for c in line.split(",")]
+            if columns is None:
+                names = cells
+                columns = {n: [] for n in names}
+                continue
+            for n, c in zip(names, cells):
+                columns[n].append(float(c))
+    if columns is None:
+        raise ValueError(f"{path}: no header line")
+    return columns
+
+
+def read_run(run_dir):
+    """run.json and probes.csv of a finished run."""
+    with open(os.path.join(run_dir, "run.json")) as f:
+        report = json.load(f)
+    if report.get("status") != "completed":
+        raise RuntimeError(f"{run_dir}: run status is {report.get('status')!r}: {report.get('error', '')}")
+    return report, read_csv(os.path.join(run_dir, "probes.csv"))
+
+
+def interpolate(x, xs, ys):
+    """Linear interpolation of ys(xs) at x; xs increasing. Outside the range: NaN."""
+    if not xs or x < xs[0] or x > xs[-1]:
+        return math.nan
+    lo, hi = 0, len(xs) - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if xs[mid] <= x:
+            lo = mid
+        else:
+            hi = mid
+    if xs[hi] == xs[lo]:
+        return ys[lo]
+    w = (x - xs[lo]) / (xs[hi] - xs[lo])
+    return ys[lo] + w * (ys[hi] - ys[lo])
+
+
+# ---------------------------------------------------------------------------------------------
+# Dam break
+
+
+def dam_break_reference():
+    ref = read_csv(DAM_BREAK_REFERENCE)
+    return ref["T"], ref["Z"]
+
+
+def dam_break_front(run_dir):
+    """Simulated surge front as (T, Z) lists. The front_position probe gives the centre of the
+    leading particle; a particle stands for a cell of width dx, so the water's edge is dx/2
+    further on. We add dx/2 (then Z = 1 exactly at T = 0, as in the experiment)."""
+    report, probes = read_run(run_dir)
+    dx = float(report["particle_spacing"])
+    a = DAM_BREAK_COLUMN_WIDTH
+    scale = math.sqrt(2.0 * GRAVITY / a)
+    T = [t * scale for t in probes["time"]]
+    Z = [(x + 0.5 * dx) / a for x in probes["front"]]
+    return T, Z
+
+
+def dam_break_errors(run_dir):
+    """Per experimental point with T <= 3: (T, Z_exp, Z_sim, relative error)."""
+    T_sim, Z_sim = dam_break_front(run_dir)
+    rows = []
+    for T, Z in zip(*dam_break_reference()):
+        if T > DAM_BREAK_T_MAX:
+            continue
+        z = interpolate(T, T_sim, Z_sim)
+        if math.isnan(z):
+            raise RuntimeError(f"{run_dir}: the run does not reach T = {T} (end it later)")
+        rows.append((T, Z, z, (z - Z) / Z))
+    return rows
+
+
+def dam_break_error(run_dir):
+    """RMS of the relative surge-front error over the Martin & Moyce points with T <= 3."""
+    rows = dam_break_errors(run_dir)
+    return math.sqrt(sum(r[3] ** 2 for r in rows) / len(rows))
+
+
+def dam_break_best_offset(run_dir, max_offset=0.4, step=0.005):
+    """(dT, RMS) minimising the RMS relative error of the simulated front shifted later by dT,
+    Z_sim(T - dT) against Z_exp(T), for 0 <= dT <= max_offset. A small RMS with dT > 0 means the
+    front speed is right and the difference is a start-up offset."""
+    T_sim, Z_sim = dam_break_front(run_dir)
+    points = [(T, Z) for T, Z in zip(*dam_break_reference()) if T <= DAM_BREAK_T_MAX]
+    best = None
+    for k in range(int(round(max_offset / step)) + 1):
+        dT = k * step
+        rel = [(interpolate(T - dT, T_sim, Z_sim) - Z) / Z for T, Z in points]
+        if any(math.isnan(r) for r in rel):
+            continue
+        rms = math.sqrt(sum(r * r for r in rel) / len(rel))
+        if best is None or rms < best[1]:
+            best = (dT, rms)
+    return best
+
+
+# ---------------------------------------------------------------------------------------------
+# Hydrostatic tank
+
+
+def hydrostatic_pressure(y):
+    """p = rho0 g (H - y) [Pa]."""
+    return HYDROSTATIC_DENSITY * GRAVITY * (HYDROSTATIC_DEPTH - y)
+
+
+def hydrostatic_errors(run_dir):
+    """{'pressure_error': largest relative error of the pressure probes at the end,
+        'speed_ratio': largest max_speed over the run / sqrt(g H),
+        per probe: relative error at the end}."""
+    _, probes = read_run(run_dir)
+    out = {}
+    worst = 0.0
+    for name, y in HYDROSTATIC_PROBES.items():
+        exact = hydrostatic_pressure(y)
+        err = abs(probes[name][-1] - exact) / exact
+        out[name] = err
+        worst = max(worst, err)
+    out["pressure_error"] = worst
+    out["speed_ratio"] = max(probes["vmax"]) / math.sqrt(GRAVITY * HYDROSTATIC_DEPTH)
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+# Metric by scene name (tools/convergence)
+
+METRICS = {
+    "dam_break_2d": {
+        "description": "RMS relative surge-front error vs Martin & Moyce 1952, T <= 3 (front + dx/2)",
+        "error": dam_break_error,
+        "extra": {},
+    },
+    "hydrostatic_tank_2d": {
+        "description": "max relative error of the pressure probes at the end vs rho0 g (H - y)",
+        "error": lambda d: hydrostatic_errors(d)["pressure_error"],
+        "extra": {"max_speed_over_sqrt_gH": lambda d: hydrostatic_errors(d)["speed_ratio"]},
+    },
+}
+
+
+# ---------------------------------------------------------------------------------------------
+# Plot of the dam-break front
+
+
+def plot_dam_break(run_dirs, png, labels=None):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    T_ref, Z_ref = dam_break_reference()
+    ax.plot(T_ref, Z_ref, "ko", label="Martin & Moyce (1952), n$^2$ = 2")
+    for i, run_dir in enumerate(run_dirs):
+        report, _ = read_run(run_dir)
+        T, Z = dam_break_front(run_dir)
+        label = labels[i] if labels else f"turbid, dx = {report['particle_spacing']:g} m"
+        label += f" (RMS rel. error {100 * dam_break_error(run_dir):.1f}%)"
+        ax.plot(T, Z, "-", label=label)
+    ax.axvline(DAM_BREAK_T_MAX, color="0.7", lw=0.8, ls="--")
+    ax.set_xlabel("T = t sqrt(2g/a)")
+    ax.set_ylabel("Z = x_front / a")
+    ax.set_xlim(0, max(3.5, max(T_ref) + 0.2))
+    ax.set_ylim(0.8, 5)
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="upper left", fontsize=8)
+    ax.set_title("2D dam break: surge front (front probe + dx/2)")
+    fig.tight_layout()
+    fig.savefig(png, dpi=120)
+    plt.close(fig)
+
+
+def main(argv):
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("plot-dam-break", help="plot the surge front of runs against Martin & Moyce")
+    p.add_argument("runs", nargs="+", help="run directories of scenes/dam_break_2d.yaml")
+    p.add_argument("--png", required=True)
+    p.add_argument("--labels", help="comma-separated legend labels, one per run")
+    e = sub.add_parser("error", help="print the metric of a run directory")
+    e.add_argument("scene", choices=sorted(METRICS))
+    e.add_argument("run")
+    args = parser.parse_args(argv)
+    if args.command == "plot-dam-break":
+        labels = args.labels.split(",") if args.labels else None
+        plot_dam_break(args.runs, args.png, labels)
+        for run_dir in args.runs:
+            for T, Z, z, rel in dam_break_errors(run_dir):
+                print(f"{run_dir}: T = {T:.2f}  Z_exp = {Z:.2f}  Z_sim = {z:.3f}  rel = {100 * rel:+.1f}%")
+            dT, rms = dam_break_best_offset(run_dir)
+            print(f"{run_dir}: RMS relative error {100 * dam_break_error(run_dir):.2f}%; "
+                  f"shifted by the best offset dT = {dT:.3f}: {100 * rms:.2f}%")
+        print(f"wrote {args.png}")
+    elif args.command == "error":
+        m = METRICS[args.scene]
+        print(f"{m['description']}: {m['error'](args.run):.6g}")
+        for name, f in m["extra"].items():
+            print(f"{name}: {f(args.run):.6g}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
