@@ -139,6 +139,33 @@ struct PressurePass {
   }
 };
 
+// Integration steps of the kick-drift-kick scheme (sph/solver.hpp), per particle.
+template <int D>
+struct KickPass {
+  ParticleView<D> P;
+  Real half_dt;
+  TURBID_HD void operator()(std::uint32_t i) const {
+    if (P.kind[i] == std::uint8_t(Kind::fluid)) P.velocity[i] += half_dt * P.acceleration[i];
+  }
+};
+
+template <int D>
+struct DriftPass {
+  ParticleView<D> P;
+  Real dt;
+  Real wall_rho0;
+  TURBID_HD void operator()(std::uint32_t i) const {
+    const Real rho = P.density[i] + dt * P.density_rate[i];
+    if (P.kind[i] == std::uint8_t(Kind::fluid)) {
+      P.position[i] += dt * P.velocity[i];
+      P.density[i] = rho;
+    } else {
+      // DBC walls never fall below rest density: a wall that sucks fluid in would let it through.
+      P.density[i] = rho < wall_rho0 ? wall_rho0 : rho;
+    }
+  }
+};
+
 // Renormalised density gradient for Antuono's δ-SPH (physics.md C3):
 // <grad rho>_i = sum_j (rho_j - rho_i) L_i grad_i W_ij V_j, L_i = [sum_j r_ji (x) grad_i W_ij V_j]^-1,
 // over fluid neighbours of the same material. Where L_i is near-singular (free surface, isolated

@@ -68,6 +68,9 @@ struct Case {
   Viscosity viscosity;
 };
 
+// Names the case in test output (instead of its bytes).
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
+
 constexpr double kDx = 0.01;    // particle spacing [m]
 constexpr double kRho0 = 1000;  // [kg/m^3]
 

@@ -50,6 +50,9 @@ struct BadScene {
   const char* checks;  // what the case is about
 };
 
+// Names the case in test output (instead of its bytes).
+void PrintTo(const BadScene& c, std::ostream* os) { *os << c.file; }
+
 // Lines and columns were counted by hand in each file: they point at the offending value, the
 // offending key, or (for a missing key) the map that lacks it.
 const BadScene kBadScenes[] = {

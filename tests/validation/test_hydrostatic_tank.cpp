@@ -25,9 +25,12 @@
 #include <unistd.h>
 #include <vector>
 
+#include "tests/validation/validation_support.hpp"
 #include "tools/runner.hpp"
 
 namespace fs = std::filesystem;
+using turbid::validation::full_mode;
+using turbid::validation::read_csv;
 
 namespace {
 
@@ -36,33 +39,6 @@ constexpr double kDensity = 1000.0;    // rho0 [kg/m^3]
 constexpr double kDepth = 1.0;         // H [m]
 constexpr double kEndTime = 2.0;       // s
 constexpr double kQuickSpacing = 0.025;  // m
-
-bool full_mode() {
-  const char* v = std::getenv("TURBID_FULL");
-  return v != nullptr && std::string(v) == "1";
-}
-
-// Columns of a CSV file with a header line; lines starting with '#' are skipped.
-std::map<std::string, std::vector<double>> read_csv(const fs::path& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("cannot open " + path.string());
-  std::map<std::string, std::vector<double>> columns;
-  std::vector<std::string> names;
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    std::stringstream ss(line);
-    std::string cell;
-    std::vector<std::string> cells;
-    while (std::getline(ss, cell, ',')) cells.push_back(cell);
-    if (names.empty()) {
-      names = cells;
-      continue;
-    }
-    for (std::size_t k = 0; k < names.size() && k < cells.size(); ++k) columns[names[k]].push_back(std::stod(cells[k]));
-  }
-  return columns;
-}
 
 double hydrostatic_pressure(double y) { return kDensity * kGravity * (kDepth - y); }
 

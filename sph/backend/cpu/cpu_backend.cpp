@@ -243,26 +243,13 @@ class CpuBackend final : public Backend {
 
   template <int D>
   void kick_impl(Real half_dt) {
-    const ParticleView<D> P = view<D>();
-    parallel_for(P.count, [P, half_dt](std::uint32_t i) {
-      if (P.kind[i] == std::uint8_t(Kind::fluid)) P.velocity[i] += half_dt * P.acceleration[i];
-    });
+    parallel_for(std::uint32_t(store_->size()), KickPass<D>{view<D>(), half_dt});
   }
 
   template <int D>
   void drift_impl(Real dt) {
-    const ParticleView<D> P = view<D>();
-    const Real wall_rho0 = params_.materials[params_.wall_material].eos.rest_density;
-    parallel_for(P.count, [P, dt, wall_rho0](std::uint32_t i) {
-      const Real rho = P.density[i] + dt * P.density_rate[i];
-      if (P.kind[i] == std::uint8_t(Kind::fluid)) {
-        P.position[i] += dt * P.velocity[i];
-        P.density[i] = rho;
-      } else {
-        // DBC walls never fall below rest density: a wall that sucks fluid in would let it through.
-        P.density[i] = rho < wall_rho0 ? wall_rho0 : rho;
-      }
-    });
+    parallel_for(std::uint32_t(store_->size()),
+                 DriftPass<D>{view<D>(), dt, params_.materials[params_.wall_material].eos.rest_density});
   }
 
   template <int D>

@@ -108,32 +108,6 @@ struct CellStartPass {
   }
 };
 
-template <int D>
-struct KickPass {
-  ParticleView<D> P;
-  Real half_dt;
-  __device__ void operator()(std::uint32_t i) const {
-    if (P.kind[i] == std::uint8_t(Kind::fluid)) P.velocity[i] += half_dt * P.acceleration[i];
-  }
-};
-
-template <int D>
-struct DriftPass {
-  ParticleView<D> P;
-  Real dt;
-  Real wall_rho0;
-  __device__ void operator()(std::uint32_t i) const {
-    const Real rho = P.density[i] + dt * P.density_rate[i];
-    if (P.kind[i] == std::uint8_t(Kind::fluid)) {
-      P.position[i] += dt * P.velocity[i];
-      P.density[i] = rho;
-    } else {
-      // DBC walls never fall below rest density: a wall that sucks fluid in would let it through.
-      P.density[i] = rho < wall_rho0 ? wall_rho0 : rho;
-    }
-  }
-};
-
 struct SpeedPair {
   float v2, a2;
 };
