@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -68,7 +69,8 @@ class Writers final : public fsi::Observer {
     const double frac = sim.time() / sim.end_time();
     const double elapsed = sim.wall_seconds() - wall_at_start_;
     const double done = sim.time() - time_at_start_;
-    const double eta = done > 0 ? elapsed * (sim.end_time() - sim.time()) / done : NAN;
+    const double left = std::max(0.0, sim.end_time() - sim.time());
+    const double eta = left == 0 ? 0.0 : done > 0 ? elapsed * left / done : NAN;
     char line[256];
     std::snprintf(line, sizeof line, "t = %.4g / %.4g s (%3.0f%%) | step %llu | dt %.2e s | %.3g particle-steps/s | ETA %s",
                   sim.time(), sim.end_time(), 100 * frac, static_cast<unsigned long long>(sim.steps()),
