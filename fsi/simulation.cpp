@@ -26,27 +26,22 @@ double height_of(const Scene& s, const Vec3d& x) {
   return -(x[0] * s.gravity[0] + x[1] * s.gravity[1] + x[2] * s.gravity[2]) / g;
 }
 
-// Highest point of a box against gravity.
-double box_top(const Scene& s, const Box& b) {
-  double top = -std::numeric_limits<double>::infinity();
-  const int corners = s.dimensions == 2 ? 4 : 8;
-  for (int c = 0; c < corners; ++c) {
-    Vec3d x{(c & 1) ? b.max[0] : b.min[0], (c & 2) ? b.max[1] : b.min[1], 0.0};
-    if (s.dimensions == 3) x[2] = (c & 4) ? b.max[2] : b.min[2];
-    top = std::max(top, height_of(s, x));
-  }
-  return top;
-}
+// Lowest and highest point of a box against gravity [m].
+struct HeightRange {
+  double bottom, top;
+  double extent() const { return top - bottom; }
+};
 
-double box_bottom(const Scene& s, const Box& b) {
-  double bottom = std::numeric_limits<double>::infinity();
+HeightRange box_heights(const Scene& s, const Box& b) {
+  HeightRange r{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
   const int corners = s.dimensions == 2 ? 4 : 8;
   for (int c = 0; c < corners; ++c) {
     Vec3d x{(c & 1) ? b.max[0] : b.min[0], (c & 2) ? b.max[1] : b.min[1], 0.0};
     if (s.dimensions == 3) x[2] = (c & 4) ? b.max[2] : b.min[2];
-    bottom = std::min(bottom, height_of(s, x));
+    r.bottom = std::min(r.bottom, height_of(s, x));
+    r.top = std::max(r.top, height_of(s, x));
   }
-  return bottom;
+  return r;
 }
 
 geometry::Aabb to_aabb(const Box& b) { return {b.min, b.max}; }
@@ -82,7 +77,7 @@ sph::PhysicsParams physics_params(const Scene& scene) {
   // Automatic sound speed: 10 x the largest free-fall speed sqrt(2 g H) over the fluid columns,
   // which keeps density variations near 1% (Monaghan 1994).
   double column = 0;
-  for (const auto& f : scene.fluids) column = std::max(column, box_top(scene, f.box) - box_bottom(scene, f.box));
+  for (const auto& f : scene.fluids) column = std::max(column, box_heights(scene, f.box).extent());
   const double auto_c0 = std::max(1.0, 10.0 * std::sqrt(2.0 * gravity_norm(scene) * column));
   p.material_count = int(scene.materials.size());
   for (std::size_t m = 0; m < scene.materials.size(); ++m) {
@@ -147,21 +142,23 @@ void Simulation::build_particles() {
   };
 
   double global_top = -std::numeric_limits<double>::infinity();
-  for (const auto& f : s.fluids) global_top = std::max(global_top, box_top(s, f.box));
+  for (const auto& f : s.fluids) global_top = std::max(global_top, box_heights(s, f.box).top);
 
   for (const auto& f : s.fluids) {
     const std::uint8_t m = material_of(f.material, f.where);
     const auto& eos = params_.materials[m].eos;
-    const double top = box_top(s, f.box);
+    const HeightRange heights = box_heights(s, f.box);
+    const double top = heights.top;
+    const double column = heights.extent();
     // Weak compressibility: the hydrostatic density at the bottom must stay near rho0.
-    const double bottom_ratio = eos.hydrostatic_density(g, top - box_bottom(s, f.box)) / eos.rest_density - 1.0;
+    const double bottom_ratio = eos.hydrostatic_density(g, column) / eos.rest_density - 1.0;
     if (bottom_ratio > 0.1) {
       const auto& ms = s.materials[m];
       std::ostringstream os;
       os << ms.where.file << ":" << ms.where.line << ":" << ms.where.column << ": error: material '" << ms.name
-         << "': sound speed " << params_.materials[m].sound_speed << " m/s compresses the " << (top - box_bottom(s, f.box))
+         << "': sound speed " << params_.materials[m].sound_speed << " m/s compresses the " << column
          << " m column by " << 100 * bottom_ratio << "% at rest; weakly compressible SPH needs about 1% (sound speed >= "
-         << 10 * std::sqrt(2 * g * (top - box_bottom(s, f.box))) << " m/s, ten times the free-fall speed)";
+         << 10 * std::sqrt(2 * g * column) << " m/s, ten times the free-fall speed)";
       throw std::invalid_argument(os.str());
     }
     for (const auto& x : geometry::fill_box(to_aabb(f.box), dx, d)) {
