@@ -200,6 +200,15 @@ nlohmann::json run_scene(const RunRequest& request) {
   const std::size_t initial_particles = sim.store().size();
   const double mass_start = fluid_mass(sim);
   Writers writers(out, sim.scene(), resume_time, request.progress);
+  if (request.progress) {
+    std::string gpu;
+    const bool on_gpu = sim.backend_name() == "cuda" && sph::cuda_device_count(&gpu) > 0;
+    std::fprintf(stderr, "turbid: %s, %zu particles (%zu fluid, %zu wall), backend %s%s%s, writing to %s\n",
+                 scene.name.c_str(), initial_particles, sim.summary().fluid_particles, sim.summary().wall_particles,
+                 sim.backend_name().c_str(), on_gpu ? " on " : "",
+                 on_gpu ? gpu.c_str() : (" with " + std::to_string(sim.threads()) + " threads").c_str(),
+                 out.string().c_str());
+  }
 
 
   nlohmann::json report;
