@@ -134,22 +134,41 @@ void write_checkpoint(const fs::path& dir_in, const sph::ParticleStore& store, c
   fs::remove_all(old, ignore);
 }
 
-json read_checkpoint(const fs::path& dir_in, sph::ParticleStore& store) {
+namespace {
+
+// The directory that holds the checkpoint: `dir`, or `dir.old` after a crash between the renames.
+fs::path checkpoint_directory(const fs::path& dir_in) {
   fs::path dir = normalized(dir_in);
   if (!fs::exists(dir / "checkpoint.json") && fs::exists(sibling(dir, ".old") / "checkpoint.json"))
     dir = sibling(dir, ".old");
-  const fs::path meta_file = dir / "checkpoint.json";
+  return dir;
+}
 
-  json meta;
-  {
-    std::ifstream in(meta_file, std::ios::binary);
-    if (!in) bad(meta_file, "cannot open (no checkpoint in '" + dir_in.string() + "')");
-    try {
-      meta = json::parse(in);
-    } catch (const json::exception& e) {
-      bad(meta_file, std::string("invalid JSON: ") + e.what());
-    }
+json read_meta(const fs::path& dir, const fs::path& dir_in) {
+  const fs::path meta_file = dir / "checkpoint.json";
+  std::ifstream in(meta_file, std::ios::binary);
+  if (!in) bad(meta_file, "cannot open (no checkpoint in '" + dir_in.string() + "')");
+  try {
+    return json::parse(in);
+  } catch (const json::exception& e) {
+    bad(meta_file, std::string("invalid JSON: ") + e.what());
   }
+  return {};
+}
+
+}  // namespace
+
+json read_checkpoint_state(const fs::path& dir_in) {
+  const fs::path dir = checkpoint_directory(dir_in);
+  const json meta = read_meta(dir, dir_in);
+  if (!meta.contains("state")) bad(dir / "checkpoint.json", "has no 'state'");
+  return meta["state"];
+}
+
+json read_checkpoint(const fs::path& dir_in, sph::ParticleStore& store) {
+  const fs::path dir = checkpoint_directory(dir_in);
+  const fs::path meta_file = dir / "checkpoint.json";
+  const json meta = read_meta(dir, dir_in);
 
   struct Entry {
     sph::FieldId id;

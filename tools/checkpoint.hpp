@@ -33,4 +33,8 @@ void write_checkpoint(const std::filesystem::path& dir, const sph::ParticleStore
 // touched; after a checksum error the store's contents are unspecified.
 nlohmann::json read_checkpoint(const std::filesystem::path& dir, sph::ParticleStore& store);
 
+// Only the caller's state saved with a checkpoint (same dir.old fallback and errors), e.g. to
+// rebuild the run before its particles are restored.
+nlohmann::json read_checkpoint_state(const std::filesystem::path& dir);
+
 }  // namespace turbid::tools

@@ -176,7 +176,7 @@ nlohmann::json run_scene(const RunRequest& request) {
     if (!fs::exists(saved_scene))
       throw std::runtime_error(saved_scene.string() + ": not found (is " + dir.string() + " a turbid run directory?)");
     scene = read_scene_file(saved_scene.string());
-    ck_state = nlohmann::json::parse(read_text(dir / "checkpoint" / "checkpoint.json"))["state"];
+    ck_state = read_checkpoint_state(dir / "checkpoint");
     scene.particle_spacing = ck_state.at("particle_spacing").get<double>();
     scene.end_time = ck_state.at("end_time").get<double>();
     resume_time = ck_state.at("time").get<double>();

@@ -496,6 +496,7 @@ TEST(Checkpoint, ReadsOldCopyAfterACrashBetweenRenames) {
   Ids tids{};
   ParticleStore t = make_target(2, tids);
   EXPECT_EQ(turbid::tools::read_checkpoint(dir, t)["step"], 7);
+  EXPECT_EQ(turbid::tools::read_checkpoint_state(dir)["step"], 7);  // the state alone, from the same old copy
   EXPECT_EQ(std::memcmp(t.raw(tids.position), s.raw(ids.position), s.size() * s.field_bytes(ids.position)), 0);
   // The next write keeps working and cleans up.
   turbid::tools::write_checkpoint(dir, s, {{"step", 8}});
