@@ -364,34 +364,46 @@ struct MomentumPass {
       else fits = false;
     });
     if (!fits) return false;
-    for (std::uint32_t k = m; k < m + W; ++k) nb[k] = i;  // padding lanes: j = i, masked below
+    // Copy what each pair needs into contiguous arrays first (scalar loads), so that the arithmetic
+    // below runs on plain arrays of W lanes, which the compiler turns into vector instructions.
+    const std::uint32_t padded = (m + W - 1) / W * W;
+    alignas(32) Real rx[D][kMaxNeighbours + W], dv[kMaxNeighbours + W], rho_j[kMaxNeighbours + W],
+        p_j[kMaxNeighbours + W], m_j[kMaxNeighbours + W], c_j[kMaxNeighbours + W];
     const Real h = prm.smoothing_length;
+    for (std::uint32_t k = 0; k < padded; ++k) {
+      const bool valid = k < m;
+      const std::uint32_t j = valid ? nb[k] : i;
+      Real vr = 0;
+      for (int a = 0; a < D; ++a) {
+        const Real d = xi[a] - P.position[j][a];
+        rx[a][k] = valid ? d : (a == 0 ? h : Real(0));  // padding: a harmless distance (q = 1)
+        vr += (vi[a] - P.velocity[j][a]) * d;
+      }
+      dv[k] = vr;
+      rho_j[k] = P.density[j];
+      p_j[k] = P.pressure[j];
+      m_j[k] = valid ? P.mass[j] : Real(0);
+      const int material_j = P.material[j];
+      c_j[k] = prm.materials[P.kind[j] == std::uint8_t(Kind::fluid) ? material_j : prm.wall_material].sound_speed;
+    }
     const Real inv_h = Real(1) / h;
     const Real eta2 = kEta2Factor * h * h;
     const Real ah = prm.artificial_viscosity * h;
     const Real c_i = Mi.sound_speed;
     Real sum[D][W] = {};
-    for (std::uint32_t k0 = 0; k0 < m; k0 += W) {
+    for (std::uint32_t k0 = 0; k0 < padded; k0 += W) {
       for (int l = 0; l < W; ++l) {
-        const std::uint32_t j = nb[k0 + std::uint32_t(l)];
-        const Real valid = (k0 + std::uint32_t(l) < m) ? Real(1) : Real(0);
-        Real r[D];
-        Real r2 = 0, vr = 0;
-        for (int a = 0; a < D; ++a) {
-          r[a] = xi[a] - P.position[j][a];
-          r2 += r[a] * r[a];
-          vr += (vi[a] - P.velocity[j][a]) * r[a];
-        }
-        const Real rs = valid > Real(0) ? r2 : h * h;  // padding: a harmless distance (q = 1)
-        const Real F = K::f_inv(std::sqrt(rs), inv_h);
-        const Real rho_j = P.density[j];
-        const Real m_j = P.mass[j] * valid;
-        const int mat_j = P.kind[j] == std::uint8_t(Kind::fluid) ? int(P.material[j]) : prm.wall_material;
-        const Real c_mean = Real(0.5) * (c_i + prm.materials[mat_j].sound_speed);
-        const Real press = -(p_i + P.pressure[j]) / (rho_i * rho_j);
-        const Real visc = vr < Real(0) ? ah * c_mean * vr / ((rs + eta2) * Real(0.5) * (rho_i + rho_j)) : Real(0);
-        const Real s = m_j * F * (press + visc);
-        for (int a = 0; a < D; ++a) sum[a][l] += s * r[a];
+        const std::uint32_t k = k0 + std::uint32_t(l);
+        Real r2 = 0;
+        for (int a = 0; a < D; ++a) r2 += rx[a][k] * rx[a][k];
+        const Real F = K::f_inv(std::sqrt(r2), inv_h);
+        const Real c_mean = Real(0.5) * (c_i + c_j[k]);
+        const Real press = -(p_i + p_j[k]) / (rho_i * rho_j[k]);
+        const Real vr = dv[k];
+        const Real visc_full = ah * c_mean * vr / ((r2 + eta2) * Real(0.5) * (rho_i + rho_j[k]));
+        const Real visc = vr < Real(0) ? visc_full : Real(0);
+        const Real s = m_j[k] * F * (press + visc);
+        for (int a = 0; a < D; ++a) sum[a][l] += s * rx[a][k];
       }
     }
     for (int a = 0; a < D; ++a) {
