@@ -50,6 +50,9 @@ class Backend {
   virtual std::optional<HealthIssue> check_health(double density_ratio_limit) = 0;
   virtual void sync_to_host() = 0;    // make the store current (no-op on the CPU)
   virtual void sync_from_host() = 0;  // the store was edited on the host (resume)
+  // After a resume's neighbour update: rebuild whatever the last force pass left for the next
+  // continuity pass (the CPU's neighbour list), so the resumed run matches bit for bit.
+  virtual void prepare_resume() {}
   virtual std::size_t pair_count() = 0;  // neighbour pairs within the support in the last force pass
 };
 

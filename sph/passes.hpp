@@ -166,6 +166,24 @@ struct DriftPass {
   }
 };
 
+// Records the neighbour list exactly as the momentum pass does, without computing anything: used
+// after a resume, so that the first continuity pass reads the same list (and gives the same bits)
+// as in the run that wrote the checkpoint.
+template <int D>
+struct RecordNeighboursPass {
+  ParticleView<D> P;
+  GridView<D> G;
+  PhysicsParams prm;
+  NeighbourList L;
+  TURBID_HD void operator()(std::uint32_t i) const {
+    if (P.kind[i] != std::uint8_t(Kind::fluid)) {
+      L.count[i] = L.stride + 1;
+      return;
+    }
+    for_each_neighbour<D>(P, G, L, prm, i, P.position[i], [](std::uint32_t, const Vec<D>&, Real) {});
+  }
+};
+
 // Renormalised density gradient for Antuono's δ-SPH (physics.md C3):
 // <grad rho>_i = sum_j (rho_j - rho_i) L_i grad_i W_ij V_j, L_i = [sum_j r_ji (x) grad_i W_ij V_j]^-1,
 // over fluid neighbours of the same material. Where L_i is near-singular (free surface, isolated
@@ -254,6 +272,14 @@ struct ContinuityPass {
     const Real hydro_k = Mi.eos.rest_density / Mi.eos.stiffness;
 
     Real drho = 0;
+#if !defined(__CUDA_ARCH__)
+    if constexpr (UniformH && Diff != Diffusion::antuono) {
+      if (fluid_i && L.entries && !L.record && L.count[i] <= L.stride && L.count[i] <= kMaxNeighbours) {
+        P.density_rate[i] = lanes(i, xi, vi, rho_i, mat_i, Mi);
+        return;
+      }
+    }
+#endif
     if (!fluid_i) {
       // A wall particle changes density only through fluid neighbours; most walls have none near.
       int c[D] = {};
@@ -291,6 +317,64 @@ struct ContinuityPass {
         }
     });
     P.density_rate[i] = drho;
+  }
+
+  // CPU, fluid particle with a recorded neighbour list: the same sums over contiguous copies of the
+  // neighbours' data in W lanes, which vectorise (see MomentumPass::lanes); lanes added in order.
+  static constexpr int W = 8;
+  static constexpr std::uint32_t kMaxNeighbours = 1024;
+  Real lanes(std::uint32_t i, const Vec<D>& xi, const Vec<D>& vi, Real rho_i, std::uint8_t mat_i,
+             const MaterialParams& Mi) const {
+    const std::uint32_t* nb = L.entries + std::size_t(i) * L.stride;
+    const std::uint32_t m = L.count[i];
+    const std::uint32_t padded = (m + W - 1) / W * W;
+    const Real h = prm.smoothing_length;
+    alignas(32) Real rx[D][kMaxNeighbours + W], dv[kMaxNeighbours + W], rho_j[kMaxNeighbours + W],
+        vol_j[kMaxNeighbours + W], same[kMaxNeighbours + W];
+    for (std::uint32_t k = 0; k < padded; ++k) {
+      const bool valid = k < m;
+      const std::uint32_t j = valid ? nb[k] : i;
+      Real vr = 0;
+      for (int a = 0; a < D; ++a) {
+        const Real d = xi[a] - P.position[j][a];
+        rx[a][k] = valid ? d : (a == 0 ? h : Real(0));  // padding: a harmless distance (q = 1)
+        vr += (vi[a] - P.velocity[j][a]) * d;
+      }
+      dv[k] = vr;
+      rho_j[k] = P.density[j];
+      vol_j[k] = (valid ? P.mass[j] : Real(0)) / P.density[j];
+      const bool s_mat = P.kind[j] == std::uint8_t(Kind::fluid) && P.material[j] == mat_i;
+      same[k] = s_mat ? Real(1) : Real(0);
+    }
+    const Real inv_h = Real(1) / h;
+    const Real eta2 = kEta2Factor * h * h;
+    const Real inv_gamma = Real(1) / Mi.eos.gamma;
+    const Real hydro_k = Mi.eos.rest_density / Mi.eos.stiffness;
+    const Real dh = prm.diffusion_delta * h * Mi.sound_speed;
+    Real sum[W] = {};
+    for (std::uint32_t k0 = 0; k0 < padded; k0 += W) {
+      for (int l = 0; l < W; ++l) {
+        const std::uint32_t k = k0 + std::uint32_t(l);
+        Real r2 = 0, gr = 0;
+        for (int a = 0; a < D; ++a) {
+          r2 += rx[a][k] * rx[a][k];
+          gr += prm.gravity[a] * rx[a][k];
+        }
+        const Real F = K::f_inv(std::sqrt(r2), inv_h);
+        Real d = pair::continuity(rho_i, vol_j[k], dv[k], F);
+        if constexpr (Diff == Diffusion::molteni) {
+          d += same[k] * pair::diffusion_molteni(dh, rho_i, rho_j[k], vol_j[k], F);
+        } else if constexpr (Diff == Diffusion::fourtakas) {
+          const Real x = -hydro_k * gr;
+          const Real rho_h = Mi.eos.rest_density * inv_gamma * x * (Real(1) + Real(0.5) * (inv_gamma - Real(1)) * x);
+          d += same[k] * pair::diffusion_fourtakas(Real(2) * dh, rho_i, rho_j[k], rho_h, r2, eta2, vol_j[k], F);
+        }
+        sum[l] += d;
+      }
+    }
+    Real t = 0;
+    for (int l = 0; l < W; ++l) t += sum[l];
+    return t;
   }
 };
 

@@ -40,6 +40,7 @@ void Solver::resume(double time, std::uint64_t steps, std::uint64_t removed) {
   // Rebuild the grid of the restored positions; they were sorted when saved, and the stable sort
   // keeps that order, so the run continues exactly as if it had not stopped.
   backend_->update_neighbours();
+  backend_->prepare_resume();
 }
 
 double Solver::next_time_step() {

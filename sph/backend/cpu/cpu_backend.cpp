@@ -82,6 +82,17 @@ class CpuBackend final : public Backend {
     return params_.dimensions == 2 ? health_impl<2>(limit) : health_impl<3>(limit);
   }
 
+  void prepare_resume() override {
+    if (params_.dimensions == 2) record_list<2>();
+    else record_list<3>();
+  }
+
+  template <int D>
+  void record_list() {
+    parallel_for(std::uint32_t(store_->size()), RecordNeighboursPass<D>{view<D>(), grid<D>(), params_, list(true)});
+    list_valid_ = true;
+  }
+
   void sync_to_host() override {}
   void sync_from_host() override {}
 
