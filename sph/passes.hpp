@@ -248,6 +248,37 @@ struct DensityGradientPass {
   }
 };
 
+// CPU lane evaluation (ContinuityPass::lanes, MomentumPass::lanes): each particle's neighbours are
+// copied into contiguous arrays first (scalar loads), so that the pair arithmetic runs on plain
+// arrays of kLanes lanes, which the compiler turns into vector instructions; the lanes are added in
+// a fixed order, so results stay deterministic.
+inline constexpr int kLanes = 8;
+inline constexpr std::uint32_t kLaneNeighbours = 1024;  // more neighbours: the plain loop is used
+
+// r_ij and v_ij . r_ij of each lane. A padding lane (beyond the last neighbour) gets the harmless
+// distance r = (h, 0, 0) (q = 1); the caller gives it zero mass.
+template <int D>
+struct LaneGeometry {
+  alignas(32) Real r[D][kLaneNeighbours + kLanes];
+  alignas(32) Real vr[kLaneNeighbours + kLanes];
+
+  void set(std::uint32_t k, const ParticleView<D>& P, const Vec<D>& xi, const Vec<D>& vi, std::uint32_t j, bool valid,
+           Real h) {
+    Real dot_v = 0;
+    for (int a = 0; a < D; ++a) {
+      const Real d = xi[a] - P.position[j][a];
+      r[a][k] = valid ? d : (a == 0 ? h : Real(0));
+      dot_v += (vi[a] - P.velocity[j][a]) * d;
+    }
+    vr[k] = dot_v;
+  }
+  Real r2(std::uint32_t k) const {
+    Real s = 0;
+    for (int a = 0; a < D; ++a) s += r[a][k] * r[a][k];
+    return s;
+  }
+};
+
 // Continuity with density diffusion (physics.md C3-C4) for every particle. Fluid particles sum
 // over all neighbours; wall particles (dynamic boundary condition, DBC) over fluid neighbours only.
 // Diffusion acts between fluid particles of the same material.
@@ -274,7 +305,7 @@ struct ContinuityPass {
     Real drho = 0;
 #if !defined(__CUDA_ARCH__)
     if constexpr (UniformH && Diff != Diffusion::antuono) {
-      if (fluid_i && L.entries && !L.record && L.count[i] <= L.stride && L.count[i] <= kMaxNeighbours) {
+      if (fluid_i && L.entries && !L.record && L.count[i] <= L.stride && L.count[i] <= kLaneNeighbours) {
         P.density_rate[i] = lanes(i, xi, vi, rho_i, mat_i, Mi);
         return;
       }
@@ -319,28 +350,20 @@ struct ContinuityPass {
     P.density_rate[i] = drho;
   }
 
-  // CPU, fluid particle with a recorded neighbour list: the same sums over contiguous copies of the
-  // neighbours' data in W lanes, which vectorise (see MomentumPass::lanes); lanes added in order.
-  static constexpr int W = 8;
-  static constexpr std::uint32_t kMaxNeighbours = 1024;
+  // CPU, fluid particle with a recorded neighbour list: the same sums in lanes (see kLanes).
+  static constexpr int W = kLanes;
   Real lanes(std::uint32_t i, const Vec<D>& xi, const Vec<D>& vi, Real rho_i, std::uint8_t mat_i,
              const MaterialParams& Mi) const {
     const std::uint32_t* nb = L.entries + std::size_t(i) * L.stride;
     const std::uint32_t m = L.count[i];
     const std::uint32_t padded = (m + W - 1) / W * W;
     const Real h = prm.smoothing_length;
-    alignas(32) Real rx[D][kMaxNeighbours + W], dv[kMaxNeighbours + W], rho_j[kMaxNeighbours + W],
-        vol_j[kMaxNeighbours + W], same[kMaxNeighbours + W];
+    LaneGeometry<D> g;
+    alignas(32) Real rho_j[kLaneNeighbours + W], vol_j[kLaneNeighbours + W], same[kLaneNeighbours + W];
     for (std::uint32_t k = 0; k < padded; ++k) {
       const bool valid = k < m;
       const std::uint32_t j = valid ? nb[k] : i;
-      Real vr = 0;
-      for (int a = 0; a < D; ++a) {
-        const Real d = xi[a] - P.position[j][a];
-        rx[a][k] = valid ? d : (a == 0 ? h : Real(0));  // padding: a harmless distance (q = 1)
-        vr += (vi[a] - P.velocity[j][a]) * d;
-      }
-      dv[k] = vr;
+      g.set(k, P, xi, vi, j, valid, h);
       rho_j[k] = P.density[j];
       vol_j[k] = (valid ? P.mass[j] : Real(0)) / P.density[j];
       const bool s_mat = P.kind[j] == std::uint8_t(Kind::fluid) && P.material[j] == mat_i;
@@ -355,13 +378,11 @@ struct ContinuityPass {
     for (std::uint32_t k0 = 0; k0 < padded; k0 += W) {
       for (int l = 0; l < W; ++l) {
         const std::uint32_t k = k0 + std::uint32_t(l);
-        Real r2 = 0, gr = 0;
-        for (int a = 0; a < D; ++a) {
-          r2 += rx[a][k] * rx[a][k];
-          gr += prm.gravity[a] * rx[a][k];
-        }
+        const Real r2 = g.r2(k);
+        Real gr = 0;
+        for (int a = 0; a < D; ++a) gr += prm.gravity[a] * g.r[a][k];
         const Real F = K::f_inv(std::sqrt(r2), inv_h);
-        Real d = pair::continuity(rho_i, vol_j[k], dv[k], F);
+        Real d = pair::continuity(rho_i, vol_j[k], g.vr[k], F);
         if constexpr (Diff == Diffusion::molteni) {
           d += same[k] * pair::diffusion_molteni(dh, rho_i, rho_j[k], vol_j[k], F);
         } else if constexpr (Diff == Diffusion::fourtakas) {
@@ -436,8 +457,8 @@ struct MomentumPass {
   // CPU: the same sums (uniform h, artificial viscosity) in W independent lanes, so that the
   // compiler can evaluate W pairs at once with vector instructions; the lanes are added in a fixed
   // order, so results stay deterministic. Returns false (nothing done) if the neighbours do not fit.
-  static constexpr int W = 8;
-  static constexpr std::uint32_t kMaxNeighbours = 1024;
+  static constexpr int W = kLanes;
+  static constexpr std::uint32_t kMaxNeighbours = kLaneNeighbours;
   bool lanes(std::uint32_t i, const Vec<D>& xi, const Vec<D>& vi, Real rho_i, Real p_i, const MaterialParams& Mi,
              Vec<D>& acc) const {
     std::uint32_t nb[kMaxNeighbours + W];
@@ -448,22 +469,15 @@ struct MomentumPass {
       else fits = false;
     });
     if (!fits) return false;
-    // Copy what each pair needs into contiguous arrays first (scalar loads), so that the arithmetic
-    // below runs on plain arrays of W lanes, which the compiler turns into vector instructions.
     const std::uint32_t padded = (m + W - 1) / W * W;
-    alignas(32) Real rx[D][kMaxNeighbours + W], dv[kMaxNeighbours + W], rho_j[kMaxNeighbours + W],
-        p_j[kMaxNeighbours + W], m_j[kMaxNeighbours + W], c_j[kMaxNeighbours + W];
+    LaneGeometry<D> g;
+    alignas(32) Real rho_j[kMaxNeighbours + W], p_j[kMaxNeighbours + W], m_j[kMaxNeighbours + W],
+        c_j[kMaxNeighbours + W];
     const Real h = prm.smoothing_length;
     for (std::uint32_t k = 0; k < padded; ++k) {
       const bool valid = k < m;
       const std::uint32_t j = valid ? nb[k] : i;
-      Real vr = 0;
-      for (int a = 0; a < D; ++a) {
-        const Real d = xi[a] - P.position[j][a];
-        rx[a][k] = valid ? d : (a == 0 ? h : Real(0));  // padding: a harmless distance (q = 1)
-        vr += (vi[a] - P.velocity[j][a]) * d;
-      }
-      dv[k] = vr;
+      g.set(k, P, xi, vi, j, valid, h);
       rho_j[k] = P.density[j];
       p_j[k] = P.pressure[j];
       m_j[k] = valid ? P.mass[j] : Real(0);
@@ -478,16 +492,15 @@ struct MomentumPass {
     for (std::uint32_t k0 = 0; k0 < padded; k0 += W) {
       for (int l = 0; l < W; ++l) {
         const std::uint32_t k = k0 + std::uint32_t(l);
-        Real r2 = 0;
-        for (int a = 0; a < D; ++a) r2 += rx[a][k] * rx[a][k];
+        const Real r2 = g.r2(k);
         const Real F = K::f_inv(std::sqrt(r2), inv_h);
         const Real c_mean = Real(0.5) * (c_i + c_j[k]);
         const Real press = -(p_i + p_j[k]) / (rho_i * rho_j[k]);
-        const Real vr = dv[k];
+        const Real vr = g.vr[k];
         const Real visc_full = ah * c_mean * vr / ((r2 + eta2) * Real(0.5) * (rho_i + rho_j[k]));
         const Real visc = vr < Real(0) ? visc_full : Real(0);
         const Real s = m_j[k] * F * (press + visc);
-        for (int a = 0; a < D; ++a) sum[a][l] += s * rx[a][k];
+        for (int a = 0; a < D; ++a) sum[a][l] += s * g.r[a][k];
       }
     }
     for (int a = 0; a < D; ++a) {
