@@ -6,6 +6,9 @@
 #include <cstdint>
 
 #include "sph/config.hpp"
+#if !defined(__CUDA_ARCH__)
+#include "sph/cpu_simd.hpp"
+#endif
 #include "sph/kernels.hpp"
 #include "sph/neighbour_grid.hpp"
 #include "sph/pair_physics.hpp"
@@ -79,6 +82,7 @@ TURBID_HD inline void for_each_neighbour(const ParticleView<D>& P, const GridVie
     // CPU: distances of a whole cell range in one vectorisable loop over coordinate arrays, then
     // the (few) pairs inside the support; same order as the plain loop below.
     constexpr std::uint32_t kChunk = 64;
+    Real d[D][kChunk];
     Real r2buf[kChunk];
     G.for_each_neighbour_range(c, [&](std::uint32_t b, std::uint32_t e) {
       for (std::uint32_t b0 = b; b0 < e; b0 += kChunk) {
@@ -86,25 +90,25 @@ TURBID_HD inline void for_each_neighbour(const ParticleView<D>& P, const GridVie
         for (std::uint32_t k = 0; k < len; ++k) {
           Real r2 = 0;
           for (int a = 0; a < D; ++a) {
-            const Real d = xi[a] - P.position_soa[std::size_t(a) * P.soa_stride + b0 + k];
-            r2 += d * d;
+            d[a][k] = xi[a] - P.position_soa[std::size_t(a) * P.soa_stride + b0 + k];
+            r2 += d[a][k] * d[a][k];
           }
           r2buf[k] = r2;
         }
-        // Branch-free compaction of the indices inside the support, then the pairs.
-        std::uint32_t hit[kChunk];
-        std::uint32_t m = 0;
-        for (std::uint32_t k = 0; k < len; ++k) {
-          hit[m] = b0 + k;
-          m += (r2buf[k] < support2 && b0 + k != i) ? 1u : 0u;
-        }
-        for (std::uint32_t k = 0; k < m; ++k) {
-          const std::uint32_t j = hit[k];
+        // The indices inside the support as a bit mask (eight comparisons at once), then only
+        // the pairs: candidates outnumber neighbours about 8 to 1 with cells of 2h.
+        std::uint64_t mask = below_mask(r2buf, len, support2);
+        if (i >= b0 && i < b0 + len) mask &= ~(std::uint64_t(1) << (i - b0));
+        while (mask) {
+          const auto k = std::uint32_t(__builtin_ctzll(mask));
+          mask &= mask - 1;
+          const std::uint32_t j = b0 + k;
           if (out) {
             if (n < L.stride) out[n] = j;
             ++n;
           }
-          const Vec<D> rij = xi - P.position[j];
+          Vec<D> rij;
+          for (int a = 0; a < D; ++a) rij[a] = d[a][k];
           f(j, rij, norm2(rij));
         }
       }
@@ -270,6 +274,18 @@ struct LaneGeometry {
       r[a][k] = valid ? d : (a == 0 ? h : Real(0));
       dot_v += (vi[a] - P.velocity[j][a]) * d;
     }
+    vr[k] = dot_v;
+  }
+  // The same in two parts, for a caller that already has r_ij from the neighbour search.
+  void set_r(std::uint32_t k, const Vec<D>& rij) {
+    for (int a = 0; a < D; ++a) r[a][k] = rij[a];
+  }
+  void set_pad(std::uint32_t k, Real h) {
+    for (int a = 0; a < D; ++a) r[a][k] = a == 0 ? h : Real(0);
+  }
+  void set_vr(std::uint32_t k, const ParticleView<D>& P, const Vec<D>& vi, std::uint32_t j) {
+    Real dot_v = 0;
+    for (int a = 0; a < D; ++a) dot_v += (vi[a] - P.velocity[j][a]) * r[a][k];
     vr[k] = dot_v;
   }
   Real r2(std::uint32_t k) const {
@@ -462,22 +478,27 @@ struct MomentumPass {
   bool lanes(std::uint32_t i, const Vec<D>& xi, const Vec<D>& vi, Real rho_i, Real p_i, const MaterialParams& Mi,
              Vec<D>& acc) const {
     std::uint32_t nb[kMaxNeighbours + W];
+    LaneGeometry<D> g;
+    const Real h = prm.smoothing_length;
     std::uint32_t m = 0;
     bool fits = true;
-    for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>&, Real) {
-      if (m < kMaxNeighbours) nb[m++] = j;
-      else fits = false;
+    for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real) {
+      if (m < kMaxNeighbours) {
+        g.set_r(m, rij);
+        nb[m++] = j;
+      } else {
+        fits = false;
+      }
     });
     if (!fits) return false;
     const std::uint32_t padded = (m + W - 1) / W * W;
-    LaneGeometry<D> g;
     alignas(32) Real rho_j[kMaxNeighbours + W], p_j[kMaxNeighbours + W], m_j[kMaxNeighbours + W],
         c_j[kMaxNeighbours + W];
-    const Real h = prm.smoothing_length;
     for (std::uint32_t k = 0; k < padded; ++k) {
       const bool valid = k < m;
       const std::uint32_t j = valid ? nb[k] : i;
-      g.set(k, P, xi, vi, j, valid, h);
+      if (!valid) g.set_pad(k, h);
+      g.set_vr(k, P, vi, j);
       rho_j[k] = P.density[j];
       p_j[k] = P.pressure[j];
       m_j[k] = valid ? P.mass[j] : Real(0);
