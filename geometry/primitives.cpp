@@ -35,37 +35,22 @@ void check_common(const char* who, double dx, int dims, const Placement& pl) {
     throw std::invalid_argument(w + ": in 2D only a rotation about z and an in-plane translation are allowed");
 }
 
-void push(SampledBody& b, const Point& p, const Point& n, double v, int layer, double surface_share) {
+void push(SampledBody& b, const Point& p, const Point& n, double depth, double v, int layer, double surface_share) {
   b.points.push_back(p);
   b.normals.push_back(n);
+  b.depth.push_back(depth);
   b.volumes.push_back(v);
   b.layer.push_back(layer);
+  b.surface_share.push_back(layer == 0 ? surface_share : 0.0);
   b.volume += v;
   if (layer == 0) b.surface_area += surface_share;
 }
 
-// p' = Rz Ry Rx p + t for points, Rz Ry Rx n for normals.
+// p' = Rz Ry Rx p + t for points, Rz Ry Rx n for normals (the dimensions are already scaled).
 void place(SampledBody& b, const Placement& pl) {
-  const double d2r = kPi / 180.0;
-  const double cx = std::cos(pl.rotation_deg[0] * d2r), sx = std::sin(pl.rotation_deg[0] * d2r);
-  const double cy = std::cos(pl.rotation_deg[1] * d2r), sy = std::sin(pl.rotation_deg[1] * d2r);
-  const double cz = std::cos(pl.rotation_deg[2] * d2r), sz = std::sin(pl.rotation_deg[2] * d2r);
-  // Rz * Ry * Rx, row-major.
-  const double m[3][3] = {
-      {cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx},
-      {sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx},
-      {-sy, cy * sx, cy * cx},
-  };
-  auto rot = [&](const Point& v) {
-    return Point{m[0][0] * v[0] + m[0][1] * v[1] + m[0][2] * v[2],
-                 m[1][0] * v[0] + m[1][1] * v[1] + m[1][2] * v[2],
-                 m[2][0] * v[0] + m[2][1] * v[1] + m[2][2] * v[2]};
-  };
-  for (auto& p : b.points) {
-    const Point r = rot(p);
-    p = {r[0] + pl.translation[0], r[1] + pl.translation[1], r[2] + pl.translation[2]};
-  }
-  for (auto& n : b.normals) n = unit(rot(n));
+  const PlacementMap map(pl);
+  for (auto& p : b.points) p = map.move(p);
+  for (auto& n : b.normals) n = unit(map.rotate(n));
 }
 
 // Circle of radius R about the origin in the xy-plane: rings r_k = R - (k + 0.5) h.
@@ -83,7 +68,7 @@ SampledBody circle(double R, double dx, int layers) {
     for (int i = 0; i < N; ++i) {
       const double a = offset + 2 * kPi * i / N;
       const Point n{std::cos(a), std::sin(a), 0.0};
-      push(b, {rk * n[0], rk * n[1], 0.0}, n, v, k, 2 * kPi * R / N0);
+      push(b, {rk * n[0], rk * n[1], 0.0}, n, R - rk, v, k, 2 * kPi * R / N0);
     }
   }
   return b;
@@ -125,17 +110,20 @@ SampledBody sample_box(Point size, double dx, int layers, int dims, const Placem
           if (idx[k] == n[k] - 1) share += face[k];
         }
         if (layers > 0 && layer >= layers) continue;
-        Point normal{0, 0, 0};
+        // Vector to the nearest face point, or to the shared edge/corner point where faces tie.
+        Point to_surface{0, 0, 0};
         const double tol = 1e-9 * best;
         for (int k = 0; k < dims; ++k) {
           const double lo = (idx[k] + 0.5) * s[k], hi = (n[k] - idx[k] - 0.5) * s[k];
           if (std::min(lo, hi) > best + tol) continue;
-          normal[k] += lo < hi - tol ? -1.0 : 1.0;  // a tie between both faces of one axis: +
+          to_surface[k] = lo < hi - tol ? -lo : hi;  // a tie between both faces of one axis: +
         }
-        normal = unit(normal);
+        const double depth = std::sqrt(to_surface[0] * to_surface[0] + to_surface[1] * to_surface[1] +
+                                       to_surface[2] * to_surface[2]);
+        const Point normal = unit(to_surface);
         Point p{-0.5 * size[0] + (ix + 0.5) * s[0], -0.5 * size[1] + (iy + 0.5) * s[1], 0.0};
         if (dims == 3) p[2] = -0.5 * size[2] + (iz + 0.5) * s[2];
-        push(b, p, normal, cell_volume, layer, share);
+        push(b, p, normal, depth, cell_volume, layer, share);
       }
   place(b, pl);
   return b;
@@ -165,7 +153,7 @@ SampledBody sample_sphere(double radius, double dx, int layers, int dims, const 
         const double rho = std::sqrt(std::max(0.0, 1.0 - z * z));
         const double a = twist + golden * i;
         const Point n = unit({rho * std::cos(a), rho * std::sin(a), z});
-        push(b, {rk * n[0], rk * n[1], rk * n[2]}, n, v, k, 4 * kPi * R * R / N0);
+        push(b, {rk * n[0], rk * n[1], rk * n[2]}, n, R - rk, v, k, 4 * kPi * R * R / N0);
       }
     }
   }
@@ -214,12 +202,15 @@ SampledBody sample_cylinder(double radius, double length, double dx, int layers,
       const double side_dist = (i + 0.5) * hr;
       const double tol = 1e-9 * std::min(side_dist, cap_dist);
       const bool side = side_dist <= cap_dist + tol, cap = cap_dist <= side_dist + tol;
+      // Distance to the nearer of side and cap, or to the rim along the normal where they tie.
+      const double depth = side && cap ? std::hypot(side_dist, cap_dist) : (side ? side_dist : cap_dist);
       const double offset = ((i + j) % 2) * kPi / N;  // stagger neighbouring rings
       for (int q = 0; q < N; ++q) {
         const double a = offset + 2 * kPi * q / N;
         const double c = std::cos(a), s = std::sin(a);
-        const Point normal = unit({side ? c : 0.0, side ? s : 0.0, cap ? cap_dir : 0.0});
-        push(b, {ring_r[i] * c, ring_r[i] * s, z}, normal, v, layer, share);
+        const Point normal =
+            unit({side ? side_dist * c : 0.0, side ? side_dist * s : 0.0, cap ? cap_dist * cap_dir : 0.0});
+        push(b, {ring_r[i] * c, ring_r[i] * s, z}, normal, depth, v, layer, share);
       }
     }
   }

@@ -6,6 +6,8 @@
 // (sphere: int |x|^2 dV = 4/5 pi R^5; circle: int |x|^2 dA = pi R^4 / 2; cylinder about its axis:
 // pi R^4 L / 2; box: int x^2 dV = a^3 b c / 12), which depend on where the particles sit and so carry
 // the real sampling error: asserted within 1 % at R/dx = 10 and to shrink when dx halves.
+// Depth: x + depth * normal must lie on the analytic surface (1e-12 m), and depth must be the exact
+// distance to the nearest surface (1e-12 m; where faces tie, the distance to their shared edge/corner).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -45,14 +47,72 @@ void expect_consistent(const SampledBody& b) {
   ASSERT_EQ(b.normals.size(), b.points.size());
   ASSERT_EQ(b.volumes.size(), b.points.size());
   ASSERT_EQ(b.layer.size(), b.points.size());
-  double v = 0;
+  ASSERT_EQ(b.depth.size(), b.points.size());
+  ASSERT_EQ(b.surface_share.size(), b.points.size());
+  double v = 0, s = 0;
   for (std::size_t i = 0; i < b.points.size(); ++i) {
     EXPECT_NEAR(norm(b.normals[i]), 1.0, 1e-12);  // unit normals, 1e-12 (brief)
     EXPECT_GT(b.volumes[i], 0.0);
     EXPECT_GE(b.layer[i], 0);
+    EXPECT_GT(b.depth[i], 0.0);
+    if (b.layer[i] != 0) {
+      EXPECT_EQ(b.surface_share[i], 0.0);
+    }
     v += b.volumes[i];
+    s += b.surface_share[i];
   }
-  EXPECT_NEAR(b.volume, v, 1e-12 * v);  // volume is the sum of the particle volumes
+  EXPECT_NEAR(b.volume, v, 1e-12 * v);        // volume is the sum of the particle volumes
+  EXPECT_NEAR(b.surface_area, s, 1e-12 * s);  // surface_area is the sum of the shares
+}
+
+Point surface_point(const SampledBody& b, std::size_t i) {
+  return {b.points[i][0] + b.depth[i] * b.normals[i][0], b.points[i][1] + b.depth[i] * b.normals[i][1],
+          b.points[i][2] + b.depth[i] * b.normals[i][2]};
+}
+
+// Depth of a particle at the given distances to the faces it may be nearest to: the minimum, or
+// the distance to the shared edge/corner point where the nearest ones tie (1e-9 relative).
+double expected_depth(std::vector<double> d) {
+  const double m = *std::min_element(d.begin(), d.end());
+  double sq = 0;
+  for (double x : d)
+    if (x <= m * (1 + 1e-9)) sq += x * x;
+  return std::sqrt(sq);
+}
+
+// Cylinder about z (or a circle when L = 0, 2D): x + depth n on the surface, depth as above.
+void expect_cylinder_depths(const SampledBody& b, double R, double L) {
+  for (std::size_t i = 0; i < b.points.size(); ++i) {
+    const Point& p = b.points[i];
+    const Point s = surface_point(b, i);
+    const double r = std::hypot(p[0], p[1]), rs = std::hypot(s[0], s[1]);
+    if (L == 0) {
+      EXPECT_NEAR(b.depth[i], R - r, 1e-12);
+      EXPECT_NEAR(rs, R, 1e-12);
+      continue;
+    }
+    EXPECT_NEAR(b.depth[i], expected_depth({R - r, 0.5 * L - std::abs(p[2])}), 1e-12);
+    const bool on_side = std::abs(rs - R) < 1e-12 && std::abs(s[2]) <= 0.5 * L + 1e-12;
+    const bool on_cap = std::abs(std::abs(s[2]) - 0.5 * L) < 1e-12 && rs <= R + 1e-12;
+    EXPECT_TRUE(on_side || on_cap) << "particle " << i;
+  }
+}
+
+// Box of `size` centred at the origin (the first `dims` axes).
+void expect_box_depths(const SampledBody& b, const Point& size, int dims) {
+  for (std::size_t i = 0; i < b.points.size(); ++i) {
+    const Point& p = b.points[i];
+    const Point s = surface_point(b, i);
+    std::vector<double> faces;
+    bool on_face = false, within = true;
+    for (int k = 0; k < dims; ++k) {
+      faces.push_back(0.5 * size[k] - std::abs(p[k]));
+      on_face = on_face || std::abs(std::abs(s[k]) - 0.5 * size[k]) < 1e-12;
+      within = within && std::abs(s[k]) <= 0.5 * size[k] + 1e-12;
+    }
+    EXPECT_NEAR(b.depth[i], expected_depth(faces), 1e-12);
+    EXPECT_TRUE(on_face && within) << "particle " << i;
+  }
 }
 
 double min_distance(const SampledBody& b) {
@@ -79,6 +139,8 @@ TEST(PrimitiveSphere, AreaVolumeAndMomentAgainstAnalytic) {
     for (std::size_t i = 0; i < b.points.size(); ++i) {
       EXPECT_GT(dot(b.normals[i], b.points[i]), 0.0);  // outward
       EXPECT_LT(norm(b.points[i]), R);
+      EXPECT_NEAR(b.depth[i], R - norm(b.points[i]), 1e-12);
+      EXPECT_NEAR(norm(surface_point(b, i)), R, 1e-12);
     }
   }
   EXPECT_LT(moment_err[1], 0.5 * moment_err[0]);  // O(dx^2): ~4x smaller, asserted 2x
@@ -95,6 +157,7 @@ TEST(PrimitiveCircle, PerimeterAreaAndMomentAgainstAnalytic) {
       EXPECT_LT(rel(b.volume, kPi * R * R), 1e-12);        // area
       moment_err[r] = rel(moment(b, {1, 1, 0}), 0.5 * kPi * std::pow(R, 4));
       EXPECT_LT(moment_err[r], 0.01);
+      expect_cylinder_depths(b, R, 0.0);
       for (std::size_t i = 0; i < b.points.size(); ++i) {
         EXPECT_EQ(b.points[i][2], 0.0);
         EXPECT_EQ(b.normals[i][2], 0.0);
@@ -116,6 +179,7 @@ TEST(PrimitiveCylinder, AreaVolumeAndMomentAgainstAnalytic) {
     EXPECT_LT(rel(b.volume, kPi * R * R * L), 1e-12);
     moment_err[r] = rel(moment(b, {1, 1, 0}), 0.5 * kPi * std::pow(R, 4) * L);
     EXPECT_LT(moment_err[r], 0.01);
+    expect_cylinder_depths(b, R, L);
     for (std::size_t i = 0; i < b.points.size(); ++i) {
       const Point& p = b.points[i];
       const Point& n = b.normals[i];
@@ -142,6 +206,7 @@ TEST(PrimitiveBox, AreaVolumeMomentAndNormals) {
     // Midpoint rule in x: relative error (s/a)^2 / 2 against the analytic a^3 b c / 12.
     moment_err[r] = rel(moment(b, {1, 0, 0}), a * a * a * bb * c / 12);
     EXPECT_LT(moment_err[r], 0.01);
+    expect_box_depths(b, {a, bb, c}, 3);
     for (std::size_t i = 0; i < b.points.size(); ++i) {
       const Point& p = b.points[i];
       EXPECT_GT(dot(b.normals[i], p), 0.0);  // outward from the centre
@@ -159,6 +224,12 @@ TEST(PrimitiveBox, AreaVolumeMomentAndNormals) {
   EXPECT_LT(rel(b2.surface_area, 2 * (a + bb)), 1e-12);
   EXPECT_LT(rel(b2.volume, a * bb), 1e-12);
   EXPECT_EQ(b2.points.size(), 20u * 12u);
+  expect_box_depths(b2, {a, bb, 0.0}, 2);
+  // A cube with an odd cell count: corner, edge and centre ties (depth to the shared edge/corner).
+  const SampledBody cube = sample_box({0.5, 0.5, 0.5}, 0.1, 0, 3);
+  expect_consistent(cube);
+  expect_box_depths(cube, {0.5, 0.5, 0.5}, 3);
+  EXPECT_NEAR(cube.depth[0], 0.05 * std::sqrt(3.0), 1e-12);  // corner cell: to the corner
 }
 
 TEST(PrimitiveLayers, ShellDepthsAndLayerVolumes) {
@@ -171,6 +242,7 @@ TEST(PrimitiveLayers, ShellDepthsAndLayerVolumes) {
   for (std::size_t i = 0; i < s.points.size(); ++i) {
     ASSERT_TRUE(s.layer[i] == 0 || s.layer[i] == 1);
     EXPECT_NEAR(1.0 - norm(s.points[i]), (s.layer[i] + 0.5) * dx, 1e-12);  // depth (k + 0.5) dx
+    EXPECT_NEAR(s.depth[i], (s.layer[i] + 0.5) * dx, 1e-12);
   }
   // Cylinder R = 0.5, L = 1.2, one layer of h = 0.1: pi R^2 L - pi (R - h)^2 (L - 2h).
   const SampledBody c = sample_cylinder(0.5, 1.2, dx, 1, 3);
@@ -178,6 +250,7 @@ TEST(PrimitiveLayers, ShellDepthsAndLayerVolumes) {
   EXPECT_LT(rel(c.volume, kPi * (0.25 * 1.2 - 0.16 * 1.0)), 1e-12);
   EXPECT_LT(rel(c.surface_area, 2 * kPi * 0.5 * 1.2 + 2 * kPi * 0.25), 1e-12);
   for (int l : c.layer) EXPECT_EQ(l, 0);
+  expect_cylinder_depths(c, 0.5, 1.2);
   // Box 1 x 0.6 x 0.4, two layers of 0.1: abc - (a - 0.4)(b - 0.4)(c - 0.4).
   const SampledBody b = sample_box({1.0, 0.6, 0.4}, dx, 2, 3);
   expect_consistent(b);
@@ -214,6 +287,7 @@ TEST(PrimitivePlacement, RotatedBoxStaysInsideAndNormalsRotate) {
     EXPECT_LT(std::abs(dot(rel_p, ez)), 0.5 * size[2]);
     const Point want_p = rz(ry(rx(local.points[i])));
     const Point want_n = rz(ry(rx(local.normals[i])));
+    EXPECT_EQ(moved.depth[i], local.depth[i]);  // depth is invariant under the placement
     for (int k = 0; k < 3; ++k) {
       EXPECT_NEAR(rel_p[k], want_p[k], 1e-12);
       EXPECT_NEAR(moved.normals[i][k], want_n[k], 1e-12);
