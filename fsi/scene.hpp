@@ -22,6 +22,7 @@ struct SourceLocation {
 
 enum class DiffusionKind { none, molteni, antuono, fourtakas };
 enum class ViscosityKind { artificial, laminar };
+enum class BoundaryKind { dbc, mdbc };  // wall treatment; see docs/choices.md
 
 struct MaterialSpec {
   std::string name;
@@ -39,9 +40,31 @@ struct Box {
   Vec3d max{0, 0, 0};
 };
 
+// A velocity field: along one axis (`axis`, `sign`), uniform or parabolic across a box's
+// transverse extent (mean `mean`; the parabola vanishes on the box faces parallel to the axis).
+struct VelocityProfile {
+  bool given = false;
+  int axis = 0;
+  int sign = 1;
+  bool parabolic = false;
+  double mean = 0;  // [m/s]
+};
+
 struct FluidBlock {
   std::string material;
   Box box;
+  VelocityProfile initial_velocity;  // across this block's box; none: at rest
+  SourceLocation where;
+};
+
+// An open boundary: a buffer zone (a box beside the fluid) whose particles feed the flow (inlet,
+// prescribed velocity) or let it leave (outlet, pressure p_b). `direction` is the flow's.
+struct OpenBoundarySpec {
+  std::string name;
+  bool inlet = true;
+  Box box;
+  VelocityProfile velocity;  // inlet: required; outlet: the direction only
+  std::string material;      // inlet: the fluid it creates (default: the first material)
   SourceLocation where;
 };
 
@@ -59,6 +82,35 @@ struct WallSpec {
   bool closed = false;        // polyline: connect the last point to the first
   int side = -1;              // polyline: layers on the right (-1) or left (+1) of the direction of travel
   int layers = 0;             // number of particle layers; 0 = enough for the kernel support (solid_box: full)
+  SourceLocation where;
+};
+
+// A structure: a solid sampled into boundary particles (kind structure), fixed in this version.
+// The fluid force on it is reported in forces.csv.
+struct StructureSpec {
+  enum class Shape { box, sphere, cylinder, mesh };
+  std::string name;
+  Shape shape = Shape::box;
+  Vec3d size{0, 0, 0};      // box: extents [m]
+  double radius = 0;        // sphere, cylinder [m] (a circle in 2D)
+  double length = 0;        // cylinder: length along its axis (z before rotation) [m]; unused in 2D
+  std::string file;         // mesh: STL, OBJ or PLY, as given in the scene
+  std::string resolved_file;  // mesh: the path to open (relative paths are relative to the scene file)
+  Vec3d position{0, 0, 0};  // translation of the shape's centre (mesh: of its own origin) [m]
+  Vec3d rotation_deg{0, 0, 0};  // about x, then y, then z [deg]; 2D: about z only
+  double scale = 1.0;       // multiplies the shape's dimensions (mesh: its coordinates)
+  int layers = 0;           // particle layers inside the surface; 0 = enough for the kernel support
+  Vec3d reference_point{0, 0, 0};  // torques are taken about this point [m] (default: position)
+  // Drag and lift coefficients, when `has_coefficients`: drag along flow_direction, lift along
+  // lift_direction; C = 2 F / (rho U^2 A) with A = reference_length in 2D (per metre of depth) and
+  // reference_area in 3D.
+  bool has_coefficients = false;
+  Vec3d flow_direction{1, 0, 0};  // unit vector
+  Vec3d lift_direction{0, 1, 0};  // unit vector, perpendicular to flow_direction
+  double reference_velocity = 0;  // [m/s]
+  double reference_density = 0;   // [kg/m^3]
+  double reference_length = 0;    // [m]
+  double reference_area = 0;      // [m^2] (3D)
   SourceLocation where;
 };
 
@@ -82,6 +134,7 @@ struct OutputSpec {
   double every = 0.0;           // output interval [s]; 0 = only the initial and final state
   bool vtk = true;              // write particles_NNNN.vtp and particles.pvd
   double checkpoint_every = 0;  // [s]; 0 = no checkpoints
+  double forces_every = 0;      // forces.csv interval [s]; 0 = at every output (every step if every = 0)
 };
 
 struct NumericsSpec {
@@ -94,11 +147,14 @@ struct NumericsSpec {
   double viscous_dt_factor = 0.125;        // dt <= factor h^2 / nu_max (Morris et al. 1997)
   double min_time_step = 1.0e-9;           // a smaller dt stops the run as collapsed [s]
   double density_ratio_limit = 0.5;        // |rho/rho0 - 1| above this stops the run [-]
+  BoundaryKind boundary = BoundaryKind::dbc;  // wall treatment for walls and structures
+  bool no_slip = false;                    // mDBC: boundary velocity mirrors the fluid's (no-slip walls)
 };
 
 struct Scene {
   std::string name;
   std::string source_file;  // the YAML file, for messages; empty when built in code
+  std::string base_directory;  // relative file names (meshes) are relative to this directory
   int dimensions = 2;
   double particle_spacing = 0.01;  // dx [m]
   double smoothing_ratio = 2.0;    // h = smoothing_ratio * dx; Wendland C2 needs h/dx near 2 on a lattice (docs/validation.md)
@@ -108,6 +164,8 @@ struct Scene {
   std::vector<MaterialSpec> materials;
   std::vector<FluidBlock> fluids;
   std::vector<WallSpec> walls;
+  std::vector<StructureSpec> structures;
+  std::vector<OpenBoundarySpec> open_boundaries;
   std::vector<ProbeSpec> probes;
   OutputSpec output;
   // Particles leaving this box are removed and counted. Default: the bounding box of all

@@ -2,6 +2,7 @@
 #include "fsi/simulation.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -9,7 +10,10 @@
 #include <stdexcept>
 
 #include "fsi/probes.hpp"
+#include "geometry/mesh.hpp"
+#include "geometry/primitives.hpp"
 #include "geometry/shapes.hpp"
+#include "sph/boundary_passes.hpp"
 #include "sph/vec.hpp"
 
 namespace turbid::fsi {
@@ -45,6 +49,163 @@ HeightRange box_heights(const Scene& s, const Box& b) {
 }
 
 geometry::Aabb to_aabb(const Box& b) { return {b.min, b.max}; }
+
+using geometry::Point;
+
+Point sub(const Point& a, const Point& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+double dot3(const Point& a, const Point& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+// mDBC ghost offsets x_g - x_b = 2 (q - x_b), q the nearest point of the wall surface (English et
+// al. 2022: the ghost node is the particle mirrored across the boundary).
+Point ghost_container(const Box& box, const Point& x, int d) {
+  // The container's fluid side is the box; wall particles lie outside it.
+  Point n{0, 0, 0};
+  for (int k = 0; k < d; ++k) n[k] = 2.0 * (std::clamp(x[k], box.min[k], box.max[k]) - x[k]);
+  return n;
+}
+
+Point ghost_solid_box(const Box& box, const Point& x, int d) {
+  // Particles fill the box; the nearest face is the surface.
+  int best_axis = 0;
+  double best = std::numeric_limits<double>::infinity(), target = 0;
+  for (int k = 0; k < d; ++k) {
+    for (double face : {box.min[k], box.max[k]}) {
+      const double dist = std::abs(face - x[k]);
+      if (dist < best) {
+        best = dist;
+        best_axis = k;
+        target = face;
+      }
+    }
+  }
+  Point n{0, 0, 0};
+  n[best_axis] = 2.0 * (target - x[best_axis]);
+  return n;
+}
+
+Point ghost_polyline(const WallSpec& w, const Point& x) {
+  double best = std::numeric_limits<double>::infinity();
+  Point q_best = x;
+  const std::size_t n = w.points.size();
+  const std::size_t segments = w.closed ? n : n - 1;
+  for (std::size_t s = 0; s < segments; ++s) {
+    const Point a = w.points[s], b = w.points[(s + 1) % n];
+    const Point ab = sub(b, a);
+    const double t = std::clamp(dot3(sub(x, a), ab) / dot3(ab, ab), 0.0, 1.0);
+    const Point q{a[0] + t * ab[0], a[1] + t * ab[1], 0.0};
+    const Point dq = sub(q, x);
+    const double dist = dot3(dq, dq);
+    if (dist < best) {
+      best = dist;
+      q_best = q;
+    }
+  }
+  return {2.0 * (q_best[0] - x[0]), 2.0 * (q_best[1] - x[1]), 0.0};
+}
+
+// Initial velocity of a fluid block at x: along the profile's axis, uniform or parabolic across
+// the block's transverse extent (mean `mean`), as an inlet prescribes it.
+Point profile_velocity(const VelocityProfile& p, const Box& box, const Point& x, int d) {
+  Point v{0, 0, 0};
+  if (!p.given) return v;
+  double u = p.mean;
+  if (p.parabolic)
+    for (int a = 0; a < d; ++a) {
+      if (a == p.axis) continue;
+      const double s = std::clamp((x[a] - box.min[a]) / (box.max[a] - box.min[a]), 0.0, 1.0);
+      u *= 6.0 * s * (1.0 - s);
+    }
+  v[p.axis] = p.sign * u;
+  return v;
+}
+
+geometry::SampledBody sample_structure(const StructureSpec& st, double dx, int dims, int layers) {
+  geometry::Placement place;
+  place.translation = st.position;
+  place.rotation_deg = st.rotation_deg;
+  place.scale = st.scale;
+  switch (st.shape) {
+    case StructureSpec::Shape::box: return geometry::sample_box(st.size, dx, layers, dims, place);
+    case StructureSpec::Shape::sphere: return geometry::sample_sphere(st.radius, dx, layers, dims, place);
+    case StructureSpec::Shape::cylinder: return geometry::sample_cylinder(st.radius, st.length, dx, layers, dims, place);
+    case StructureSpec::Shape::mesh: return geometry::sample_mesh(geometry::load_mesh(st.resolved_file), dx, layers, dims, place);
+  }
+  return {};
+}
+
+// Which fluid lattice points lie inside a structure or closer than half a spacing to its surface:
+// the signed distance of a point to the tangent plane at the surface point of its nearest
+// structure particle (x_b + depth_b n_b, normal n_b) decides. Deep inside a body with few layers
+// the nearest particle is one of the innermost layer, whose outward normal still gives a negative
+// distance.
+class StructureCarver {
+ public:
+  StructureCarver(const std::vector<geometry::SampledBody>& bodies, double dx) : dx_(dx), cell_(2.0 * dx) {
+    for (const auto& b : bodies)
+      for (std::size_t i = 0; i < b.points.size(); ++i) {
+        const Point s{b.points[i][0] + b.depth[i] * b.normals[i][0], b.points[i][1] + b.depth[i] * b.normals[i][1],
+                      b.points[i][2] + b.depth[i] * b.normals[i][2]};
+        pts_.push_back({b.points[i], s, b.normals[i]});
+        for (int k = 0; k < 3; ++k) {
+          lo_[k] = std::min(lo_[k], b.points[i][k] - dx);
+          hi_[k] = std::max(hi_[k], b.points[i][k] + dx);
+        }
+      }
+    if (pts_.empty()) return;
+    for (int k = 0; k < 3; ++k) n_[k] = std::max(1, int(std::ceil((hi_[k] - lo_[k]) / cell_)));
+    cells_.resize(std::size_t(n_[0]) * n_[1] * n_[2]);
+    for (std::size_t i = 0; i < pts_.size(); ++i) cells_[index(cell_of(pts_[i].x))].push_back(i);
+  }
+
+  bool blocks(const Point& p) const {
+    if (pts_.empty()) return false;
+    for (int k = 0; k < 3; ++k)
+      if (p[k] < lo_[k] - dx_ || p[k] > hi_[k] + dx_) return false;
+    const auto c = cell_of(p);
+    const int max_ring = std::max({n_[0], n_[1], n_[2]});
+    double best = std::numeric_limits<double>::infinity();
+    std::size_t best_i = 0;
+    for (int ring = 0; ring <= max_ring; ++ring) {
+      // Every point in a later ring is at least (ring) cells away.
+      if (std::isfinite(best) && double(ring - 1) * cell_ > std::sqrt(best)) break;
+      for (int z = c[2] - ring; z <= c[2] + ring; ++z)
+        for (int y = c[1] - ring; y <= c[1] + ring; ++y)
+          for (int x = c[0] - ring; x <= c[0] + ring; ++x) {
+            if (std::max({std::abs(x - c[0]), std::abs(y - c[1]), std::abs(z - c[2])}) != ring) continue;
+            if (x < 0 || y < 0 || z < 0 || x >= n_[0] || y >= n_[1] || z >= n_[2]) continue;
+            for (std::size_t i : cells_[index({x, y, z})]) {
+              const Point d = sub(p, pts_[i].x);
+              const double r2 = dot3(d, d);
+              if (r2 < best) {
+                best = r2;
+                best_i = i;
+              }
+            }
+          }
+    }
+    if (!std::isfinite(best)) return false;
+    const Entry& e = pts_[best_i];
+    return dot3(sub(p, e.surface), e.normal) < 0.5 * dx_ * (1.0 - 1e-6);
+  }
+
+ private:
+  struct Entry {
+    Point x, surface, normal;
+  };
+  std::array<int, 3> cell_of(const Point& p) const {
+    std::array<int, 3> c{};
+    for (int k = 0; k < 3; ++k) c[k] = std::clamp(int((p[k] - lo_[k]) / cell_), 0, n_[k] - 1);
+    return c;
+  }
+  std::size_t index(const std::array<int, 3>& c) const {
+    return (std::size_t(c[2]) * std::size_t(n_[1]) + std::size_t(c[1])) * std::size_t(n_[0]) + std::size_t(c[0]);
+  }
+  double dx_, cell_;
+  double lo_[3] = {1e300, 1e300, 1e300}, hi_[3] = {-1e300, -1e300, -1e300};
+  int n_[3] = {1, 1, 1};
+  std::vector<Entry> pts_;
+  std::vector<std::vector<std::size_t>> cells_;
+};
 
 }  // namespace
 
@@ -88,12 +249,37 @@ sph::PhysicsParams physics_params(const Scene& scene) {
     p.materials[m].dynamic_viscosity = sph::Real(ms.viscosity);
   }
   p.wall_material = 0;
+  p.boundary = scene.numerics.boundary == BoundaryKind::mdbc ? sph::Boundary::mdbc : sph::Boundary::dbc;
+  p.mdbc_no_slip = scene.numerics.no_slip;
+  p.body_count = int(scene.structures.size());
+  p.zone_count = int(scene.open_boundaries.size());
+  for (std::size_t k = 0; k < scene.open_boundaries.size(); ++k) {
+    const auto& ob = scene.open_boundaries[k];
+    sph::BufferZone& z = p.zones[k];
+    const int a = ob.velocity.axis;
+    z.type = ob.inlet ? sph::ZoneType::inlet : sph::ZoneType::outlet;
+    z.profile = ob.velocity.parabolic ? sph::Profile::parabolic : sph::Profile::uniform;
+    z.axis = a;
+    z.sign = sph::Real(ob.velocity.sign);
+    // The face towards the fluid: downstream for an inlet, upstream for an outlet.
+    const bool downstream_is_max = ob.velocity.sign > 0;
+    z.plane = sph::Real(ob.inlet == downstream_is_max ? ob.box.max[a] : ob.box.min[a]);
+    z.thickness = sph::Real(ob.box.max[a] - ob.box.min[a]);
+    z.velocity = sph::Real(ob.velocity.mean);
+    for (int k2 = 0; k2 < 3; ++k2) {
+      z.lo[k2] = sph::Real(ob.box.min[k2]);
+      z.hi[k2] = sph::Real(ob.box.max[k2]);
+    }
+    z.material = 0;
+    for (std::size_t m = 0; m < scene.materials.size(); ++m)
+      if (scene.materials[m].name == ob.material) z.material = std::uint8_t(m);
+  }
   return p;
 }
 
 Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::move(scene)) {
   params_ = physics_params(scene_);
-  ids_ = sph::register_fields(store_, params_);
+  ids_ = sph::register_fields(store_, params_, !scene_.structures.empty());
   build_particles();
 
   std::unique_ptr<sph::Backend> backend;
@@ -129,6 +315,11 @@ void Simulation::build_particles() {
     double density;
     std::uint8_t material;
     sph::Kind kind;
+    geometry::Point ghost{0, 0, 0};  // mDBC ghost offset (boundary particles)
+    std::uint8_t body = sph::kNoBody;
+    double volume = 0;               // particle volume [m^d]
+    Point velocity{0, 0, 0};
+    std::uint8_t zone = sph::kNoZone;
   };
   std::vector<Item> items;
   summary_.particles_per_material.assign(s.materials.size(), 0);
@@ -143,6 +334,32 @@ void Simulation::build_particles() {
 
   double global_top = -std::numeric_limits<double>::infinity();
   for (const auto& f : s.fluids) global_top = std::max(global_top, box_heights(s, f.box).top);
+
+  // Structures are sampled first: fluid lattice points inside them are left out.
+  std::vector<geometry::SampledBody> bodies;
+  for (const auto& st : s.structures) {
+    const int layers = st.layers > 0 ? st.layers : std::max(1, int(std::ceil(2.0 * s.smoothing_ratio - 1e-9)));
+    try {
+      bodies.push_back(sample_structure(st, dx, d, layers));
+    } catch (const std::exception& e) {
+      std::ostringstream os;
+      os << st.where.file << ":" << st.where.line << ":" << st.where.column << ": error: structure '" << st.name
+         << "': " << e.what();
+      throw std::invalid_argument(os.str());
+    }
+    if (bodies.back().points.empty()) {
+      std::ostringstream os;
+      os << st.where.file << ":" << st.where.line << ":" << st.where.column << ": error: structure '" << st.name
+         << "' is smaller than the particle spacing " << dx << " m and yields no particles";
+      throw std::invalid_argument(os.str());
+    }
+    // The body's volume: a mesh reports the whole solid's; a primitive the sampled layers', so it
+    // is sampled once more, filled.
+    double volume = bodies.back().volume;
+    if (st.shape != StructureSpec::Shape::mesh) volume = sample_structure(st, dx, d, 0).volume;
+    summary_.structures.push_back({st.name, bodies.back().points.size(), bodies.back().surface_area, volume});
+  }
+  const StructureCarver carver(bodies, dx);
 
   for (const auto& f : s.fluids) {
     const std::uint8_t m = material_of(f.material, f.where);
@@ -162,8 +379,13 @@ void Simulation::build_particles() {
       throw std::invalid_argument(os.str());
     }
     for (const auto& x : geometry::fill_box(to_aabb(f.box), dx, d)) {
+      if (carver.blocks(x)) {
+        ++summary_.fluid_removed_by_structures;
+        continue;
+      }
       const double depth = std::max(0.0, top - height_of(s, x));
-      items.push_back({x, eos.hydrostatic_density(g, depth), m, sph::Kind::fluid});
+      items.push_back({x, eos.hydrostatic_density(g, depth), m, sph::Kind::fluid, {0, 0, 0}, sph::kNoBody, cell_volume,
+                       profile_velocity(f.initial_velocity, f.box, x, d)});
       ++summary_.particles_per_material[m];
     }
   }
@@ -182,10 +404,56 @@ void Simulation::build_particles() {
       // Walls start at the hydrostatic density of the water above them, so the first steps carry
       // no pressure jump between fluid and wall.
       const double depth = std::isfinite(global_top) ? std::max(0.0, global_top - height_of(s, x)) : 0.0;
-      items.push_back({x, wall_eos.hydrostatic_density(g, depth), 0, sph::Kind::wall});
+      Point ghost{0, 0, 0};
+      switch (w.kind) {
+        case WallSpec::Kind::container: ghost = ghost_container(w.box, x, d); break;
+        case WallSpec::Kind::solid_box: ghost = ghost_solid_box(w.box, x, d); break;
+        case WallSpec::Kind::polyline: ghost = ghost_polyline(w, x); break;
+      }
+      items.push_back({x, wall_eos.hydrostatic_density(g, depth), 0, sph::Kind::wall, ghost, sph::kNoBody, cell_volume});
     }
   }
   summary_.wall_particles = items.size() - summary_.fluid_particles;
+  for (std::size_t b = 0; b < bodies.size(); ++b) {
+    const auto& body = bodies[b];
+    for (std::size_t i = 0; i < body.points.size(); ++i) {
+      const Point& x = body.points[i];
+      const double depth = std::isfinite(global_top) ? std::max(0.0, global_top - height_of(s, x)) : 0.0;
+      const Point ghost{2 * body.depth[i] * body.normals[i][0], 2 * body.depth[i] * body.normals[i][1],
+                        d == 3 ? 2 * body.depth[i] * body.normals[i][2] : 0.0};
+      items.push_back({x, wall_eos.hydrostatic_density(g, depth), 0, sph::Kind::structure, ghost, std::uint8_t(b),
+                       body.volumes[i]});
+    }
+  }
+  summary_.structure_particles = items.size() - summary_.fluid_particles - summary_.wall_particles;
+  const double support = 2.0 * double(params_.smoothing_length);
+  for (std::size_t k = 0; k < s.open_boundaries.size(); ++k) {
+    const auto& ob = s.open_boundaries[k];
+    const sph::BufferZone& z = params_.zones[k];
+    if (double(z.thickness) < support * (1 - 1e-9)) {
+      std::ostringstream os;
+      os << ob.where.file << ":" << ob.where.line << ":" << ob.where.column << ": error: open boundary '" << ob.name
+         << "' is " << z.thickness << " m thick along the flow, less than the kernel support 2h = " << support
+         << " m at this spacing";
+      throw std::invalid_argument(os.str());
+    }
+    const auto& eos = params_.materials[z.material].eos;
+    for (const auto& x : geometry::fill_box(to_aabb(ob.box), dx, d)) {
+      const double depth = std::isfinite(global_top) ? std::max(0.0, global_top - height_of(s, x)) : 0.0;
+      Point v{0, 0, 0};
+      if (ob.inlet && d == 2) {
+        const auto u = sph::zone_velocity<2>(z, sph::Vec<2>{{sph::Real(x[0]), sph::Real(x[1])}});
+        v = {double(u[0]), double(u[1]), 0.0};
+      } else if (ob.inlet) {
+        const auto u = sph::zone_velocity<3>(z, sph::Vec<3>{{sph::Real(x[0]), sph::Real(x[1]), sph::Real(x[2])}});
+        v = {double(u[0]), double(u[1]), double(u[2])};
+      }
+      items.push_back({x, eos.hydrostatic_density(g, depth), z.material, sph::Kind::buffer, {0, 0, 0}, sph::kNoBody,
+                       cell_volume, v, std::uint8_t(k)});
+    }
+  }
+  summary_.buffer_particles =
+      items.size() - summary_.fluid_particles - summary_.wall_particles - summary_.structure_particles;
   if (summary_.fluid_particles == 0) throw std::invalid_argument("the scene has no fluid particles");
 
   // Domain: as given, or the particles' bounding box grown by 10% per side.
@@ -216,10 +484,19 @@ void Simulation::build_particles() {
   auto* mat = store_.data<std::uint8_t>(ids_.material);
   auto* kind = store_.data<std::uint8_t>(ids_.kind);
   auto* id = store_.data<std::uint32_t>(ids_.id);
+  auto* ghost = ids_.boundary_normal >= 0 ? static_cast<sph::Real*>(store_.raw(ids_.boundary_normal)) : nullptr;
+  auto* body = ids_.body >= 0 ? store_.data<std::uint8_t>(ids_.body) : nullptr;
+  auto* zone = ids_.zone >= 0 ? store_.data<std::uint8_t>(ids_.zone) : nullptr;
+  auto* vel = static_cast<sph::Real*>(store_.raw(ids_.velocity));
   for (std::size_t i = 0; i < items.size(); ++i) {
     for (int k = 0; k < d; ++k) x[i * std::size_t(d) + std::size_t(k)] = sph::Real(items[i].x[k]);
+    if (ghost)
+      for (int k = 0; k < d; ++k) ghost[i * std::size_t(d) + std::size_t(k)] = sph::Real(items[i].ghost[k]);
+    if (body) body[i] = items[i].body;
+    if (zone) zone[i] = items[i].zone;
+    for (int k = 0; k < d; ++k) vel[i * std::size_t(d) + std::size_t(k)] = sph::Real(items[i].velocity[k]);
     rho[i] = sph::Real(items[i].density);
-    mass[i] = sph::Real(items[i].density * cell_volume);  // V = m / rho = dx^d
+    mass[i] = sph::Real(items[i].density * items[i].volume);  // V = m / rho: dx^d on the lattice
     h[i] = params_.smoothing_length;
     mat[i] = items[i].material;
     kind[i] = std::uint8_t(items[i].kind);
@@ -240,6 +517,9 @@ void Simulation::start() { solver_->start(); }
 void Simulation::resume(double time, std::uint64_t steps, std::uint64_t removed, std::uint64_t output_index,
                         std::uint64_t checkpoint_index, std::uint64_t particle_steps) {
   solver_->resume(time, steps, removed);
+  forces_index_ = 0;
+  if (scene_.output.forces_every > 0)
+    while (double(forces_index_) * scene_.output.forces_every <= time) ++forces_index_;
   output_index_ = output_index;
   checkpoint_index_ = checkpoint_index;
   particle_steps_ = particle_steps;
@@ -249,6 +529,12 @@ void Simulation::step() {
   const double dt = solver_->next_time_step();
   particle_steps_ += store_.size();
   solver_->step(dt);
+}
+
+std::vector<sph::BodyLoad> Simulation::structure_loads() {
+  std::vector<std::array<double, 3>> reference;
+  for (const auto& st : scene_.structures) reference.push_back(st.reference_point);
+  return solver_->backend().body_loads(reference);
 }
 
 std::vector<double> Simulation::probe_values() {
@@ -267,6 +553,20 @@ void Simulation::run(Observer& observer) {
     observer.on_output(*this);
     ++output_index_;
   }
+  // forces.csv: every forces_every, else at every output (every step without an output interval).
+  const bool structures = !scene_.structures.empty();
+  const double f_every = scene_.output.forces_every;
+  auto forces_due = [&](bool output_now) {
+    if (!structures) return false;
+    if (f_every > 0) return time() >= double(forces_index_) * f_every;
+    return output_now || every == 0;
+  };
+  auto write_forces = [&] {
+    observer.on_forces(*this);
+    if (f_every > 0)
+      while (double(forces_index_) * f_every <= time()) ++forces_index_;
+  };
+  if (structures && time() == 0.0 && forces_index_ == 0) write_forces();
   const auto t0 = clock::now();
   const double wall_before = wall_seconds_;
   auto last_progress = t0;
@@ -275,7 +575,9 @@ void Simulation::run(Observer& observer) {
     const auto now = clock::now();
     wall_seconds_ = wall_before + std::chrono::duration<double>(now - t0).count();
     const bool last = time() >= scene_.end_time;
-    if ((every > 0 && time() >= output_due()) || last) {
+    const bool output_now = (every > 0 && time() >= output_due()) || last;
+    if (forces_due(output_now)) write_forces();
+    if (output_now) {
       sync_to_host();
       observer.on_output(*this);
       if (every > 0)

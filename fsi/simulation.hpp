@@ -19,10 +19,22 @@ struct RunOptions {
   int threads = 0;               // CPU threads; 0 = OpenMP default
 };
 
+// A structure as sampled: what `turbid check` and run.json report.
+struct StructureSummary {
+  std::string name;
+  std::size_t particles = 0;
+  double surface_area = 0;  // of the sampled surface [m^2] (perimeter [m] in 2D)
+  double volume = 0;        // of the sampled solid [m^3] (area [m^2] in 2D)
+};
+
 // Counts and derived values a user sees in `turbid check` and run.json.
 struct WorldSummary {
   std::size_t fluid_particles = 0;
   std::size_t wall_particles = 0;
+  std::size_t structure_particles = 0;
+  std::size_t buffer_particles = 0;  // open-boundary zones
+  std::size_t fluid_removed_by_structures = 0;  // fluid lattice points inside or touching a structure
+  std::vector<StructureSummary> structures;
   std::vector<std::size_t> particles_per_material;
   double smoothing_length = 0;     // [m]
   std::vector<double> sound_speed; // per material [m/s]
@@ -39,6 +51,7 @@ class Observer {
   virtual void on_output(Simulation&) {}      // at t = 0 and every output interval
   virtual void on_checkpoint(Simulation&) {}  // every checkpoint interval
   virtual void on_progress(const Simulation&) {}  // about twice a second of wall time
+  virtual void on_forces(Simulation&) {}          // every forces interval (scenes with structures)
   virtual void on_finish(Simulation&) {}
 };
 
@@ -65,6 +78,8 @@ class Simulation {
   double end_time() const { return scene_.end_time; }
   std::uint64_t steps() const { return solver_->steps(); }
   std::uint64_t removed() const { return solver_->removed(); }
+  std::uint64_t inflow() const { return solver_->inflow(); }    // particles created at inlets
+  std::uint64_t outflow() const { return solver_->outflow(); }  // particles gone through outlets
   double last_time_step() const { return solver_->last_time_step(); }
   double wall_seconds() const { return wall_seconds_; }
   double particle_steps_per_second() const;
@@ -84,6 +99,9 @@ class Simulation {
   void step();
 
   std::vector<double> probe_values();  // evaluated now (synchronises the store)
+  // Force and torque of the fluid on every structure (scene order), from the last force pass.
+  std::vector<sph::BodyLoad> structure_loads();
+  std::uint64_t forces_index() const { return forces_index_; }
   void sync_to_host() { solver_->backend().sync_to_host(); }
 
  private:
@@ -100,6 +118,7 @@ class Simulation {
   double wall_seconds_ = 0;
   std::uint64_t output_index_ = 0;
   std::uint64_t checkpoint_index_ = 0;
+  std::uint64_t forces_index_ = 0;
   std::uint64_t particle_steps_ = 0;
 };
 

@@ -7,8 +7,11 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
+#include "sph/body_loads.hpp"
 #include "sph/fields.hpp"
+#include "sph/open_boundary.hpp"
 #include "sph/particle_store.hpp"
 #include "sph/physics_params.hpp"
 
@@ -45,6 +48,8 @@ class Backend {
   virtual void compute_forces() = 0;        // pressure from density, momentum
   virtual void kick(double half_dt) = 0;    // v += half_dt a (fluid)
   virtual void drift(double dt) = 0;        // x += dt v (fluid); rho += dt drho/dt (all)
+  // After the drift, with open boundaries: particles crossing buffer-zone planes (open_boundary.hpp).
+  virtual OpenBoundaryCounts update_open_boundaries() = 0;
   virtual StepStats stats() = 0;
   // First particle with a non-finite value or a density ratio |rho/rho0 - 1| above the limit.
   virtual std::optional<HealthIssue> check_health(double density_ratio_limit) = 0;
@@ -54,6 +59,9 @@ class Backend {
   // continuity pass (the CPU's neighbour list), so the resumed run matches bit for bit.
   virtual void prepare_resume() {}
   virtual std::size_t pair_count() = 0;  // neighbour pairs within the support in the last force pass
+  // Force and torque of the fluid on each structure, from the last force pass (the exact reaction
+  // of the fluid's accelerations); reference[k] is the point structure k's torque is taken about.
+  virtual std::vector<BodyLoad> body_loads(const std::vector<std::array<double, 3>>& reference) = 0;
 };
 
 std::unique_ptr<Backend> make_cpu_backend(int threads);

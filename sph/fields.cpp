@@ -3,7 +3,7 @@
 
 namespace turbid::sph {
 
-FieldIds register_fields(ParticleStore& s, const PhysicsParams& p) {
+FieldIds register_fields(ParticleStore& s, const PhysicsParams& p, bool structures) {
   const int d = p.dimensions;
   // 2D runs are per metre of depth: mass is then kg/m and volumes m^2.
   const char* mass_unit = d == 2 ? "kg/m" : "kg";
@@ -24,6 +24,16 @@ FieldIds register_fields(ParticleStore& s, const PhysicsParams& p) {
   f.id = s.add_field({"id", "", ScalarType::u32, 1, true, true, true, Carry::recompute});
   if (p.diffusion == Diffusion::antuono)
     f.density_gradient = s.add_field({"density_gradient", "kg/m^4", ScalarType::f32, d, false, false, false, Carry::recompute});
+  // Ghost node offset x_g - x_b: twice the particle's depth below the wall surface, along the
+  // outward normal (zero for fluid).
+  if (p.boundary == Boundary::mdbc)
+    f.boundary_normal = s.add_field({"boundary_normal", "m", ScalarType::f32, d, true, true, true, Carry::copy});
+  if (structures) {
+    const char* force_unit = d == 2 ? "N/m" : "N";
+    f.body = s.add_field({"body", "", ScalarType::u8, 1, true, true, true, Carry::copy});
+    f.structure_force = s.add_field({"structure_force", force_unit, ScalarType::f32, d, true, false, false, Carry::recompute});
+  }
+  if (p.zone_count > 0) f.zone = s.add_field({"zone", "", ScalarType::u8, 1, true, true, true, Carry::copy});
   return f;
 }
 

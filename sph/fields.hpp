@@ -10,9 +10,13 @@ struct FieldIds {
   FieldId density = -1, density_rate = -1, pressure = -1;
   FieldId mass = -1, smoothing_length = -1, material = -1, kind = -1, id = -1;
   FieldId density_gradient = -1;  // registered only for Antuono diffusion
+  FieldId boundary_normal = -1;   // registered only for mDBC
+  FieldId body = -1, structure_force = -1;  // registered only when the scene has structures
+  FieldId zone = -1;                        // registered only with open boundaries
 };
 
 // Registers what `params` needs (a water-only run with Fourtakas diffusion gets no gradient field).
-FieldIds register_fields(ParticleStore& store, const PhysicsParams& params);
+// `structures`: the scene has structures (body index and per-particle force fields).
+FieldIds register_fields(ParticleStore& store, const PhysicsParams& params, bool structures = false);
 
 }  // namespace turbid::sph

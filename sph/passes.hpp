@@ -31,6 +31,10 @@ struct ParticleView {
   std::uint8_t* material = nullptr;
   std::uint8_t* kind = nullptr;
   Vec<D>* density_gradient = nullptr;  // only with Antuono diffusion
+  Vec<D>* boundary_normal = nullptr;   // only with mDBC: ghost node offset x_g - x_b of boundary particles [m]
+  Vec<D>* structure_force = nullptr;   // only with structures: force of the fluid on each structure particle
+  std::uint8_t* body = nullptr;        // only with structures: structure index (kNoBody for others)
+  std::uint8_t* zone = nullptr;        // only with open boundaries: buffer zone index (kNoZone for others)
   // CPU only: positions as one array per coordinate (component a at a * soa_stride), a copy made
   // at each sort so that distance checks vectorise; valid until the next drift.
   const Real* position_soa = nullptr;
@@ -163,6 +167,8 @@ struct DriftPass {
     if (P.kind[i] == std::uint8_t(Kind::fluid)) {
       P.position[i] += dt * P.velocity[i];
       P.density[i] = rho;
+    } else if (P.kind[i] == std::uint8_t(Kind::buffer)) {
+      P.position[i] += dt * P.velocity[i];  // density and velocity: BufferPass
     } else {
       // DBC walls never fall below rest density: a wall that sucks fluid in would let it through.
       P.density[i] = rho < wall_rho0 ? wall_rho0 : rho;
@@ -328,6 +334,12 @@ struct ContinuityPass {
     }
 #endif
     if (!fluid_i) {
+      // With mDBC the boundary density is extrapolated from the fluid (MdbcPass), not integrated;
+      // buffer particles get theirs from BufferPass.
+      if (prm.boundary == Boundary::mdbc || P.kind[i] == std::uint8_t(Kind::buffer)) {
+        P.density_rate[i] = Real(0);
+        return;
+      }
       // A wall particle changes density only through fluid neighbours; most walls have none near.
       int c[D] = {};
       G.cell_of(xi, c);
@@ -415,6 +427,32 @@ struct ContinuityPass {
   }
 };
 
+// Acceleration of fluid particle i (velocity vi, density rho_i, pressure p_i, smoothing length
+// h_i, material Mi) due to particle j at r_ij = x_i - x_j: pressure and viscosity (physics.md C10,
+// C2). The structure-force pass evaluates the same function for the same pair, so the force on a
+// structure is exactly the reaction of what it does to the fluid.
+template <int D, class K, bool UniformH>
+TURBID_HD inline Vec<D> momentum_pair(const ParticleView<D>& P, const PhysicsParams& prm, const Vec<D>& vi, Real rho_i,
+                                      Real p_i, Real h_i, const MaterialParams& Mi, std::uint32_t j, const Vec<D>& rij,
+                                      Real r2) {
+  const Real h = pair_h<D, K>(P, prm, UniformH, h_i, j);
+  if (!UniformH && r2 >= Real(4) * h * h) return Vec<D>::zero();
+  const Real F = K::f_inv(std::sqrt(r2), Real(1) / h);
+  const Real rho_j = P.density[j];
+  const Real m_j = P.mass[j];
+  const std::uint8_t mat_j = P.kind[j] == std::uint8_t(Kind::fluid) ? P.material[j] : std::uint8_t(prm.wall_material);
+  const MaterialParams& Mj = prm.materials[mat_j];
+  const Vec<D> vij = vi - P.velocity[j];
+  const Real eta2 = kEta2Factor * h * h;
+  Real s = pair::pressure(m_j, p_i, P.pressure[j], rho_i, rho_j, F);
+  if (prm.viscosity == Viscosity::artificial) {
+    s += pair::artificial_viscosity(prm.artificial_viscosity, h, Real(0.5) * (Mi.sound_speed + Mj.sound_speed),
+                                    Real(0.5) * (rho_i + rho_j), m_j, dot(vij, rij), r2, eta2, F);
+    return s * rij;
+  }
+  return s * rij + pair::laminar_viscosity(m_j, Mi.dynamic_viscosity, Mj.dynamic_viscosity, rho_i, rho_j, r2, eta2, F) * vij;
+}
+
 // Momentum (pressure gradient, viscosity, gravity) for fluid particles; walls get zero.
 template <int D, class K, bool UniformH>
 struct MomentumPass {
@@ -447,24 +485,7 @@ struct MomentumPass {
     }
 #endif
     for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
-        const Real h = pair_h<D, K>(P, prm, UniformH, h_i, j);
-        if (!UniformH && r2 >= Real(4) * h * h) return;
-        const Real F = K::f_inv(std::sqrt(r2), Real(1) / h);
-        const Real rho_j = P.density[j];
-        const Real m_j = P.mass[j];
-        const std::uint8_t mat_j = P.kind[j] == std::uint8_t(Kind::fluid) ? P.material[j] : std::uint8_t(prm.wall_material);
-        const MaterialParams& Mj = prm.materials[mat_j];
-        const Vec<D> vij = vi - P.velocity[j];
-        const Real eta2 = kEta2Factor * h * h;
-        Real s = pair::pressure(m_j, p_i, P.pressure[j], rho_i, rho_j, F);
-        if (artificial) {
-          s += pair::artificial_viscosity(prm.artificial_viscosity, h, Real(0.5) * (Mi.sound_speed + Mj.sound_speed),
-                                          Real(0.5) * (rho_i + rho_j), m_j, dot(vij, rij), r2, eta2, F);
-          acc += s * rij;
-        } else {
-          acc += s * rij;
-          acc += pair::laminar_viscosity(m_j, Mi.dynamic_viscosity, Mj.dynamic_viscosity, rho_i, rho_j, r2, eta2, F) * vij;
-        }
+      acc += momentum_pair<D, K, UniformH>(P, prm, vi, rho_i, p_i, h_i, Mi, j, rij, r2);
     });
     for (int k = 0; k < D; ++k) acc[k] += prm.gravity[k];
     P.acceleration[i] = acc;

@@ -12,9 +12,38 @@ inline constexpr int kMaxMaterials = 8;
 
 enum class Diffusion : std::uint8_t { none, molteni, antuono, fourtakas };
 enum class Viscosity : std::uint8_t { artificial, laminar };
+// Wall treatment: the dynamic boundary condition (boundary particles integrate continuity like
+// fluid) or the modified DBC of English et al. (2022), whose boundary density is extrapolated from
+// the fluid at a ghost node mirrored across the wall (physics.md C5).
+enum class Boundary : std::uint8_t { dbc, mdbc };
+
+inline constexpr std::uint8_t kNoBody = 0xff;  // body index of particles that belong to no structure
+inline constexpr int kMaxBodies = 254;
 
 // Particle kinds; the kind field is a u8.
 enum class Kind : std::uint8_t { fluid = 0, wall = 1, structure = 2, buffer = 3 };
+
+// Open boundaries: buffer zones beside the fluid (Tafuni et al. 2018, simplified). Buffer particles
+// (kind buffer) move with their velocity; at an inlet it is prescribed and the density is
+// extrapolated from the fluid across the zone's plane; at an outlet the density is the rest
+// density (pressure p_b) and the velocity the fluid's, interpolated at the mirrored point.
+inline constexpr int kMaxZones = 4;
+inline constexpr std::uint8_t kNoZone = 0xff;
+enum class ZoneType : std::uint8_t { inlet, outlet };
+enum class Profile : std::uint8_t { uniform, parabolic };
+
+struct BufferZone {
+  ZoneType type = ZoneType::inlet;
+  Profile profile = Profile::uniform;
+  int axis = 0;           // flow axis
+  Real sign = 1;          // +1: the flow goes towards +axis
+  Real plane = 0;         // the zone's face towards the fluid, along axis [m]
+  Real thickness = 0;     // extent of the zone along axis [m]
+  Real velocity = 0;      // inlet: mean velocity [m/s]
+  Real lo[3] = {0, 0, 0}; // the zone's box [m] (transverse extent of the parabolic profile)
+  Real hi[3] = {0, 0, 0};
+  std::uint8_t material = 0;  // material of the fluid an inlet creates
+};
 
 struct MaterialParams {
   TaitEos eos;
@@ -27,6 +56,11 @@ struct PhysicsParams {
   KernelKind kernel = KernelKind::wendland_c2;
   Diffusion diffusion = Diffusion::fourtakas;
   Viscosity viscosity = Viscosity::artificial;
+  Boundary boundary = Boundary::dbc;
+  bool mdbc_no_slip = false;   // mDBC: boundary velocity mirrors the fluid's (no-slip), else stays the wall's
+  int body_count = 0;          // structures (particles of kind structure carry their index in `body`)
+  int zone_count = 0;          // open-boundary buffer zones (buffer particles carry their index in `zone`)
+  BufferZone zones[kMaxZones];
   Real diffusion_delta = Real(0.1);
   Real artificial_viscosity = Real(0.01);
   Real smoothing_length = 0;   // h of the initial lattice [m]

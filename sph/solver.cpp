@@ -58,6 +58,11 @@ void Solver::step(double dt) {
   backend_->kick(0.5 * dt);
   backend_->compute_density_rate();
   backend_->drift(dt);
+  if (params_.zone_count > 0) {
+    const OpenBoundaryCounts c = backend_->update_open_boundaries();
+    inflow_ += c.inflow;
+    outflow_ += c.outflow;
+  }
   removed_ += backend_->update_neighbours();
   backend_->compute_forces();
   backend_->kick(0.5 * dt);

@@ -54,6 +54,8 @@ class Solver {
   double time() const { return time_; }
   std::uint64_t steps() const { return steps_; }
   std::uint64_t removed() const { return removed_; }
+  std::uint64_t inflow() const { return inflow_; }    // particles created at inlets
+  std::uint64_t outflow() const { return outflow_; }  // particles gone through outlets
   double last_time_step() const { return last_dt_; }
   Backend& backend() { return *backend_; }
   const PhysicsParams& params() const { return params_; }
@@ -70,6 +72,8 @@ class Solver {
   double last_dt_ = 0;
   std::uint64_t steps_ = 0;
   std::uint64_t removed_ = 0;
+  std::uint64_t inflow_ = 0;
+  std::uint64_t outflow_ = 0;
 };
 
 }  // namespace turbid::sph

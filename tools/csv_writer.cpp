@@ -36,8 +36,8 @@ std::string errno_text() { return std::error_code(errno, std::generic_category()
 
 }  // namespace
 
-std::string CsvSeriesWriter::header_line(const std::vector<std::string>& columns) {
-  std::string h = "time";
+std::string CsvSeriesWriter::header_line(const std::vector<std::string>& columns, const std::string& time_column) {
+  std::string h = csv_cell(time_column);
   for (const auto& c : columns) {
     h += ',';
     h += csv_cell(c);
@@ -46,7 +46,7 @@ std::string CsvSeriesWriter::header_line(const std::vector<std::string>& columns
 }
 
 CsvSeriesWriter::CsvSeriesWriter(fs::path file, std::vector<std::string> columns,
-                                 std::optional<double> resume_time)
+                                 std::optional<double> resume_time, std::string time_column)
     : file_(std::move(file)), columns_(std::move(columns)) {
   if (file_.has_parent_path()) {
     std::error_code ec;
@@ -54,7 +54,7 @@ CsvSeriesWriter::CsvSeriesWriter(fs::path file, std::vector<std::string> columns
     if (ec)
       throw std::runtime_error("cannot create directory '" + file_.parent_path().string() + "': " + ec.message());
   }
-  const std::string header = header_line(columns_);
+  const std::string header = header_line(columns_, time_column);
 
   // Keep the rows a resumed run has already produced, up to the checkpoint's time.
   std::string kept = header + "\n";

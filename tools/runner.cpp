@@ -11,6 +11,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "fsi/forces.hpp"
 #include "fsi/simulation.hpp"
 #include "tools/checkpoint.hpp"
 #include "tools/csv_writer.hpp"
@@ -49,6 +50,7 @@ class Writers final : public fsi::Observer {
     std::vector<std::string> names;
     for (const auto& p : scene.probes) names.push_back(p.name);
     probes_.emplace(out / "probes.csv", names, resume_time);
+    if (!scene.structures.empty()) forces_.emplace(out / "forces.csv", fsi::force_columns(scene), resume_time, "time [s]");
     if (scene.output.vtk) {
       vtk_.emplace(out, scene.dimensions);
       if (resume_time) vtk_->resume_after(*resume_time);
@@ -59,6 +61,10 @@ class Writers final : public fsi::Observer {
     const auto values = sim.probe_values();
     probes_->append(sim.time(), values);
     if (vtk_) vtk_->write(sim.store(), sim.time());
+  }
+
+  void on_forces(fsi::Simulation& sim) override {
+    if (forces_) forces_->append(sim.time(), fsi::force_row(sim.scene(), sim.structure_loads()));
   }
 
   void on_checkpoint(fsi::Simulation& sim) override { save_checkpoint(sim); }
@@ -99,6 +105,8 @@ class Writers final : public fsi::Observer {
     state["wall_seconds"] = sim.wall_seconds();
     state["particle_spacing"] = sim.scene().particle_spacing;
     state["end_time"] = sim.scene().end_time;
+    // Meshes named relative to the scene file are found from here when the run is resumed.
+    state["scene_directory"] = sim.scene().base_directory;
     write_checkpoint(out_ / "checkpoint", sim.store(), state);
   }
 
@@ -114,6 +122,7 @@ class Writers final : public fsi::Observer {
   double last_plain_ = 0;
   double wall_at_start_ = 0, time_at_start_ = 0;
   std::optional<CsvSeriesWriter> probes_;
+  std::optional<CsvSeriesWriter> forces_;
   std::optional<VtkSeriesWriter> vtk_;
 };
 
@@ -147,10 +156,24 @@ std::string describe_scene(const fsi::Scene& scene) {
   fsi::Simulation sim(scene, opts);
   const auto& s = sim.summary();
   std::ostringstream os;
-  const std::size_t total = s.fluid_particles + s.wall_particles;
+  const std::size_t total = s.fluid_particles + s.wall_particles + s.structure_particles;
   os << "scene            " << scene.name << " (" << scene.dimensions << "D)\n";
   os << "spacing          " << scene.particle_spacing << " m, h = " << s.smoothing_length << " m\n";
-  os << "particles        " << total << " (fluid " << s.fluid_particles << ", wall " << s.wall_particles << ")\n";
+  os << "particles        " << total << " (fluid " << s.fluid_particles << ", wall " << s.wall_particles;
+  if (s.structure_particles > 0) os << ", structure " << s.structure_particles;
+  os << ")\n";
+  os << "wall treatment   "
+     << (scene.numerics.boundary == fsi::BoundaryKind::mdbc
+             ? (scene.numerics.no_slip ? "mDBC (no-slip)" : "mDBC (wall velocity)")
+             : "DBC")
+     << "\n";
+  const bool two_d = scene.dimensions == 2;
+  for (const auto& st : s.structures)
+    os << "  structure " << st.name << ": " << st.particles << " particles, surface "
+       << st.surface_area << (two_d ? " m (perimeter)" : " m^2") << ", volume " << st.volume
+       << (two_d ? " m^2 (area)" : " m^3") << "\n";
+  if (s.fluid_removed_by_structures > 0)
+    os << "  fluid lattice points left out inside structures: " << s.fluid_removed_by_structures << "\n";
   for (std::size_t m = 0; m < scene.materials.size(); ++m)
     os << "  material " << scene.materials[m].name << ": " << s.particles_per_material[m]
        << " particles, sound speed " << s.sound_speed[m] << " m/s\n";
@@ -175,8 +198,8 @@ nlohmann::json run_scene(const RunRequest& request) {
     const fs::path saved_scene = dir / "scene.yaml";
     if (!fs::exists(saved_scene))
       throw std::runtime_error(saved_scene.string() + ": not found (is " + dir.string() + " a turbid run directory?)");
-    scene = read_scene_file(saved_scene.string());
     ck_state = read_checkpoint_state(dir / "checkpoint");
+    scene = read_scene_file(saved_scene.string(), ck_state.value("scene_directory", std::string()));
     scene.particle_spacing = ck_state.at("particle_spacing").get<double>();
     scene.end_time = ck_state.at("end_time").get<double>();
     resume_time = ck_state.at("time").get<double>();
@@ -203,8 +226,9 @@ nlohmann::json run_scene(const RunRequest& request) {
   if (request.progress) {
     std::string gpu;
     const bool on_gpu = sim.backend_name() == "cuda" && sph::cuda_device_count(&gpu) > 0;
-    std::fprintf(stderr, "turbid: %s, %zu particles (%zu fluid, %zu wall), backend %s%s%s, writing to %s\n",
+    std::fprintf(stderr, "turbid: %s, %zu particles (%zu fluid, %zu wall, %zu structure), backend %s%s%s, writing to %s\n",
                  scene.name.c_str(), initial_particles, sim.summary().fluid_particles, sim.summary().wall_particles,
+                 sim.summary().structure_particles,
                  sim.backend_name().c_str(), on_gpu ? " on " : "",
                  on_gpu ? gpu.c_str() : (" with " + std::to_string(sim.threads()) + " threads").c_str(),
                  out.string().c_str());
@@ -218,12 +242,22 @@ nlohmann::json run_scene(const RunRequest& request) {
   report["smoothing_length"] = sim.summary().smoothing_length;
   report["fluid_particles"] = sim.summary().fluid_particles;
   report["wall_particles"] = sim.summary().wall_particles;
+  if (!scene.structures.empty()) {
+    report["structure_particles"] = sim.summary().structure_particles;
+    nlohmann::json list = nlohmann::json::array();
+    for (const auto& st : sim.summary().structures)
+      list.push_back({{"name", st.name}, {"particles", st.particles}, {"surface_area", st.surface_area},
+                      {"volume", st.volume}});
+    report["structures"] = list;
+  }
   report["backend"] = sim.backend_name();
   report["threads"] = sim.threads();
   report["git_revision"] = TURBID_GIT_REVISION;
   report["version"] = TURBID_VERSION;
   report["units"] = {{"simulated_time", "s"}, {"wall_seconds", "s"}, {"particle_steps_per_second", "1/s"},
-                     {"fluid_mass", scene.dimensions == 2 ? "kg/m" : "kg"}};
+                     {"fluid_mass", scene.dimensions == 2 ? "kg/m" : "kg"},
+                     {"surface_area", scene.dimensions == 2 ? "m" : "m^2"},
+                     {"volume", scene.dimensions == 2 ? "m^2" : "m^3"}};
   std::string status = "completed";
   try {
     if (request.resume) {
@@ -246,6 +280,11 @@ nlohmann::json run_scene(const RunRequest& request) {
   report["particles"] = initial_particles;
   report["particles_end"] = sim.store().size();
   report["removed_particles"] = sim.removed();
+  if (!scene.open_boundaries.empty()) {
+    report["buffer_particles"] = sim.summary().buffer_particles;
+    report["inflow_particles"] = sim.inflow();
+    report["outflow_particles"] = sim.outflow();
+  }
   report["steps"] = sim.steps();
   report["simulated_time"] = sim.time();
   report["wall_seconds"] = sim.wall_seconds();

@@ -5,6 +5,8 @@
 // the YAML node. The first error stops the read: a scene either parses completely or not at all.
 #include "tools/scene_reader.hpp"
 
+#include "sph/physics_params.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -197,7 +199,8 @@ class MapView {
 
 class Reader {
  public:
-  explicit Reader(std::string file) : file_(std::move(file)) {}
+  explicit Reader(std::string file, std::string relative_to = {})
+      : file_(std::move(file)), relative_to_(std::move(relative_to)) {}
 
   fsi::Scene read(const std::string& yaml_text);
 
@@ -285,6 +288,26 @@ class Reader {
     return p;
   }
 
+  // A flow direction along an axis: one of -x, +x, -y, +y (, -z, +z).
+  fsi::VelocityProfile direction(const Value& v, int dims) const {
+    fsi::VelocityProfile p;
+    const std::size_t k = choice(v, std::vector<std::string>(kFaceName, kFaceName + 2 * dims));
+    p.given = true;
+    p.axis = int(k / 2);
+    p.sign = k % 2 == 0 ? -1 : +1;
+    return p;
+  }
+
+  // {direction: +x, profile: uniform | parabolic, mean: U}; without `with_speed` only the direction.
+  fsi::VelocityProfile profile(const MapView& m, int dims, bool with_speed) const {
+    fsi::VelocityProfile p = direction(m.need("direction"), dims);
+    if (with_speed) {
+      if (auto pr = m.get("profile")) p.parabolic = choice(*pr, {"uniform", "parabolic"}) == 1;
+      p.mean = number(m.need("mean"), non_negative(), "m/s");
+    }
+    return p;
+  }
+
   fsi::Box box(const Value& v, int dims) const {
     MapView m(*this, v, {"min", "max"});
     fsi::Box b;
@@ -308,10 +331,13 @@ class Reader {
   void read_materials(const Value& v, fsi::Scene& scene) const;
   void read_walls(const Value& v, fsi::Scene& scene, std::vector<YAML::Mark>& wall_marks) const;
   void read_fluids(const Value& v, fsi::Scene& scene, const std::vector<YAML::Mark>& wall_marks) const;
+  void read_structures(const Value& v, fsi::Scene& scene) const;
+  void read_open_boundaries(const Value& v, fsi::Scene& scene) const;
   void read_probes(const Value& v, fsi::Scene& scene) const;
   void read_output(const Value& v, fsi::OutputSpec& out) const;
 
   std::string file_;
+  std::string relative_to_;  // directory of relative mesh paths; empty: the scene file's
 };
 
 // --- MapView ------------------------------------------------------------------------------------
@@ -375,8 +401,9 @@ Value MapView::need(std::string_view key) const {
 
 // --- the schema ---------------------------------------------------------------------------------
 
-const std::vector<std::string> kTopKeys = {"name",      "dimensions", "resolution", "time",  "gravity", "numerics",
-                                           "materials", "walls",      "fluids",     "probes", "output",  "domain"};
+const std::vector<std::string> kTopKeys = {"name",   "dimensions", "resolution", "time",   "gravity",
+                                           "numerics", "materials", "walls",     "structures", "fluids",
+                                           "open_boundaries", "probes", "output", "domain"};
 const std::vector<std::string> kFutureMaterialModels = {"bingham", "herschel_bulkley"};
 
 fsi::Scene Reader::read(const std::string& yaml_text) {
@@ -393,16 +420,18 @@ fsi::Scene Reader::read(const std::string& yaml_text) {
 
   fsi::Scene scene;
   scene.source_file = file_;
+  {
+    std::error_code ec;
+    const std::filesystem::path base =
+        relative_to_.empty() ? std::filesystem::path(file_).parent_path() : std::filesystem::path(relative_to_);
+    scene.base_directory = std::filesystem::absolute(base, ec).lexically_normal().string();
+  }
   try {
     const YAML::Node& doc = documents[0];
     Value root{doc, doc.Mark(), "the scene"};
     if (!doc.IsMap())
       fail(root.mark, "the scene must be a map with the keys " + join(kTopKeys) + ", got " + describe(doc));
-    MapView top(*this, root, kTopKeys, false);
-    for (const auto& e : top.entries())
-      if (e.key == "structures")
-        fail(e.key_mark, "'structures' are not supported by the scene reader yet");
-    top.check_keys();
+    MapView top(*this, root, kTopKeys);
 
     scene.name = text(top.need("name"));
     {
@@ -434,6 +463,8 @@ fsi::Scene Reader::read(const std::string& yaml_text) {
     }
     std::vector<YAML::Mark> wall_marks;
     if (auto v = top.get("walls")) read_walls(*v, scene, wall_marks);
+    if (auto v = top.get("structures")) read_structures(*v, scene);
+    if (auto v = top.get("open_boundaries")) read_open_boundaries(*v, scene);
     read_fluids(top.need("fluids"), scene, wall_marks);
     if (auto v = top.get("probes")) read_probes(*v, scene);
     if (auto v = top.get("output")) read_output(*v, scene.output);
@@ -445,7 +476,16 @@ fsi::Scene Reader::read(const std::string& yaml_text) {
 }
 
 void Reader::read_numerics(const Value& v, fsi::NumericsSpec& n) const {
-  MapView m(*this, v, {"kernel", "density_diffusion", "viscosity", "min_time_step", "max_density_variation"});
+  MapView m(*this, v, {"kernel", "density_diffusion", "viscosity", "boundary", "min_time_step", "max_density_variation"});
+  if (auto bv = m.get("boundary")) {
+    MapView b(*this, *bv, {"type", "velocity"});
+    n.boundary = choice(b.need("type"), {"dbc", "mdbc"}) == 0 ? fsi::BoundaryKind::dbc : fsi::BoundaryKind::mdbc;
+    if (auto vel = b.get("velocity")) {
+      if (n.boundary != fsi::BoundaryKind::mdbc)
+        fail(b.key_mark("velocity"), "'velocity' applies only to the 'mdbc' boundary (DBC walls keep their own velocity)");
+      n.no_slip = choice(*vel, {"no_slip", "wall"}) == 0;
+    }
+  }
   if (auto k = m.get("kernel"))
     n.kernel = choice(*k, {"wendland_c2", "cubic_spline"}) == 0 ? sph::KernelKind::wendland_c2
                                                                  : sph::KernelKind::cubic_spline;
@@ -583,7 +623,7 @@ void Reader::read_fluids(const Value& v, fsi::Scene& scene, const std::vector<YA
   const std::vector<Value> items = list(v);
   if (items.empty()) fail(v.mark, "'fluids' must list at least one fluid block");
   for (const Value& item : items) {
-    MapView m(*this, item, {"material", "box"});
+    MapView m(*this, item, {"material", "box", "initial_velocity"});
     fsi::FluidBlock block;
     block.where = where(item.mark);
     const Value mv = m.need("material");
@@ -641,7 +681,169 @@ void Reader::read_fluids(const Value& v, fsi::Scene& scene, const std::vector<YA
                             fmt(b.min[k]) + " to " + fmt(b.max[k]) + ", domain " + fmt(d.min[k]) + " to " +
                             fmt(d.max[k]) + "); its particles would be removed at the start");
     }
+    if (auto iv = m.get("initial_velocity")) {
+      MapView pv(*this, *iv, {"direction", "profile", "mean"});
+      block.initial_velocity = profile(pv, dims, true);
+    }
     scene.fluids.push_back(block);
+  }
+}
+
+void Reader::read_structures(const Value& v, fsi::Scene& scene) const {
+  const int dims = scene.dimensions;
+  const std::vector<std::string> shapes = {"box", "sphere", "cylinder", "mesh"};
+  std::map<std::string, int> first_line;
+  for (const Value& item : list(v)) {
+    MapView m(*this, item,
+              {"name", "box", "sphere", "cylinder", "mesh", "position", "rotation", "scale", "layers",
+               "reference_point", "coefficients"});
+    fsi::StructureSpec st;
+    st.where = where(item.mark);
+    const Value nv = m.need("name");
+    st.name = text(nv);
+    if (st.name.find_first_of(",\"\n\r ") != std::string::npos)
+      fail(nv.mark, "structure name '" + st.name + "' must not contain spaces, commas, quotes or line breaks (it "
+                        "names the columns of forces.csv); use letters, digits, '_' or '-'");
+    if (const auto it = first_line.find(st.name); it != first_line.end())
+      fail(nv.mark, "duplicate structure name '" + st.name + "' (first used at line " + std::to_string(it->second) +
+                        "); structure names must be unique");
+    first_line[st.name] = nv.mark.line + 1;
+    if (scene.structures.size() >= std::size_t(sph::kMaxBodies))
+      fail(item.mark, "at most " + std::to_string(sph::kMaxBodies) + " structures are supported");
+
+    std::vector<std::string> present;
+    for (const auto& sh : shapes)
+      if (m.has(sh)) present.push_back(sh);
+    if (present.empty())
+      fail(item.mark, item.name + " needs exactly one shape: 'box', 'sphere', 'cylinder' or 'mesh', found none");
+    if (present.size() > 1)
+      fail(m.key_mark(present[1]), item.name + " has both '" + present[0] + "' and '" + present[1] +
+                                       "'; give exactly one shape per structure");
+    const std::string& shape = present[0];
+    const Value sv = m.need(shape);
+    if (shape == "box") {
+      st.shape = fsi::StructureSpec::Shape::box;
+      MapView b(*this, sv, {"size"});
+      const Value size = b.need("size");
+      st.size = point(size, dims, "m");
+      for (int k = 0; k < dims; ++k)
+        if (!(st.size[std::size_t(k)] > 0))
+          fail(size.mark, "every component of 'size' must be positive [m], got " + describe(size.node));
+    } else if (shape == "sphere") {
+      st.shape = fsi::StructureSpec::Shape::sphere;
+      MapView b(*this, sv, {"radius"});
+      st.radius = number(b.need("radius"), positive(), "m");
+    } else if (shape == "cylinder") {
+      st.shape = fsi::StructureSpec::Shape::cylinder;
+      MapView b(*this, sv, dims == 3 ? std::vector<std::string>{"radius", "length"} : std::vector<std::string>{"radius"},
+                false);
+      if (dims == 2 && b.has("length"))
+        fail(b.key_mark("length"), "a 2D cylinder is a circle: 'length' does not apply (the scene is per metre of depth)");
+      b.check_keys();
+      st.radius = number(b.need("radius"), positive(), "m");
+      if (dims == 3) st.length = number(b.need("length"), positive(), "m");
+    } else {
+      st.shape = fsi::StructureSpec::Shape::mesh;
+      MapView b(*this, sv, {"file"});
+      const Value fv = b.need("file");
+      st.file = text(fv, "a file name (STL, OBJ or PLY)");
+      std::filesystem::path path(st.file);
+      if (path.is_relative()) path = std::filesystem::path(scene.base_directory) / path;
+      st.resolved_file = path.lexically_normal().string();
+      std::error_code ec;
+      if (!std::filesystem::is_regular_file(st.resolved_file, ec))
+        fail(fv.mark, "mesh file '" + st.file + "' not found (looked for " + st.resolved_file +
+                          "; relative paths are relative to the scene file)");
+    }
+    if (auto x = m.get("position")) st.position = point(*x, dims, "m");
+    if (auto x = m.get("rotation")) {
+      if (dims == 2) {
+        st.rotation_deg[2] = number(*x, any_number(), "deg");
+      } else {
+        st.rotation_deg = point(*x, 3, "deg");
+      }
+    }
+    if (auto x = m.get("scale")) st.scale = number(*x, positive());
+    if (auto x = m.get("layers")) st.layers = integer(*x, 1, "an integer >= 1");
+    st.reference_point = st.position;
+    if (auto x = m.get("reference_point")) st.reference_point = point(*x, dims, "m");
+    if (auto cv = m.get("coefficients")) {
+      MapView c(*this, *cv, {"flow_direction", "lift_direction", "velocity", "density", "length", "area"}, false);
+      if (dims == 2 && c.has("area"))
+        fail(c.key_mark("area"), "'area' applies to 3D scenes; in 2D the coefficients use 'length' (per metre of depth)");
+      c.check_keys();
+      st.has_coefficients = true;
+      auto unit_vector = [&](const Value& val) {
+        Vec3d d = point(val, dims, "");
+        const double n = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        if (!(n > 0)) fail(val.mark, val.name + " must not be the zero vector");
+        for (auto& x : d) x /= n;
+        return d;
+      };
+      const Value fd = c.need("flow_direction");
+      st.flow_direction = unit_vector(fd);
+      if (auto l = c.get("lift_direction")) {
+        st.lift_direction = unit_vector(*l);
+      } else if (dims == 2) {
+        st.lift_direction = {-st.flow_direction[1], st.flow_direction[0], 0};  // +90 degrees in the plane
+      } else {
+        fail(cv->mark, "'coefficients' in a 3D scene needs 'lift_direction' (a unit vector perpendicular to "
+                       "'flow_direction')");
+      }
+      const double dot = st.flow_direction[0] * st.lift_direction[0] + st.flow_direction[1] * st.lift_direction[1] +
+                         st.flow_direction[2] * st.lift_direction[2];
+      if (std::abs(dot) > 1e-6)
+        fail(c.key_mark(c.has("lift_direction") ? "lift_direction" : "flow_direction"),
+             "'lift_direction' must be perpendicular to 'flow_direction' (their dot product is " + fmt(dot) + ")");
+      st.reference_velocity = number(c.need("velocity"), positive(), "m/s");
+      st.reference_density = number(c.need("density"), positive(), "kg/m^3");
+      st.reference_length = number(c.need("length"), positive(), "m");
+      if (dims == 3) st.reference_area = number(c.need("area"), positive(), "m^2");
+    }
+    scene.structures.push_back(st);
+  }
+}
+
+void Reader::read_open_boundaries(const Value& v, fsi::Scene& scene) const {
+  const int dims = scene.dimensions;
+  std::vector<std::string> material_names;
+  for (const auto& m : scene.materials) material_names.push_back(m.name);
+  for (const Value& item : list(v)) {
+    MapView m(*this, item, {"name", "type", "box", "direction", "velocity", "material"});
+    fsi::OpenBoundarySpec ob;
+    ob.where = where(item.mark);
+    ob.name = text(m.need("name"));
+    ob.inlet = choice(m.need("type"), {"inlet", "outlet"}) == 0;
+    const Value bv = m.need("box");
+    ob.box = box(bv, dims);
+    require_ordered(bv, ob.box, dims);
+    ob.velocity = direction(m.need("direction"), dims);
+    if (ob.inlet) {
+      MapView pv(*this, m.need("velocity"), {"profile", "mean"});
+      if (auto pr = pv.get("profile")) ob.velocity.parabolic = choice(*pr, {"uniform", "parabolic"}) == 1;
+      ob.velocity.mean = number(pv.need("mean"), positive(), "m/s");
+      ob.material = scene.materials.front().name;
+      if (auto mv = m.get("material")) {
+        ob.material = text(*mv);
+        if (std::find(material_names.begin(), material_names.end(), ob.material) == material_names.end())
+          fail(mv->mark, "unknown material '" + ob.material + "'" + did_you_mean(ob.material, material_names) +
+                             " (defined materials: " + join(material_names) + ")");
+      }
+    } else {
+      for (const char* key : {"velocity", "material"})
+        if (m.has(key))
+          fail(m.key_mark(key), "'" + std::string(key) + "' applies only to an inlet; an outlet takes the fluid's "
+                                "velocity and holds the pressure at the background pressure");
+    }
+    const double thickness = ob.box.max[std::size_t(ob.velocity.axis)] - ob.box.min[std::size_t(ob.velocity.axis)];
+    const double needed = 2.0 * scene.smoothing_ratio * scene.particle_spacing;
+    if (thickness < needed - 1e-9 * needed)
+      fail(bv.mark, "the " + std::string(ob.inlet ? "inlet" : "outlet") + " zone is " + fmt(thickness) +
+                        " m thick along the flow, less than the kernel support 2h = " + fmt(needed) +
+                        " m; fluid next to it would miss neighbours");
+    if (scene.open_boundaries.size() >= std::size_t(sph::kMaxZones))
+      fail(item.mark, "at most " + std::to_string(sph::kMaxZones) + " open boundaries are supported");
+    scene.open_boundaries.push_back(ob);
   }
 }
 
@@ -697,7 +899,8 @@ void Reader::read_probes(const Value& v, fsi::Scene& scene) const {
 }
 
 void Reader::read_output(const Value& v, fsi::OutputSpec& out) const {
-  MapView m(*this, v, {"every", "vtk", "checkpoint_every"});
+  MapView m(*this, v, {"every", "vtk", "checkpoint_every", "forces_every"});
+  if (auto x = m.get("forces_every")) out.forces_every = number(*x, non_negative(), "s");
   if (auto x = m.get("every")) out.every = number(*x, non_negative(), "s");
   if (auto x = m.get("vtk")) out.vtk = boolean(*x);
   if (auto x = m.get("checkpoint_every")) out.checkpoint_every = number(*x, non_negative(), "s");
@@ -709,7 +912,7 @@ fsi::Scene read_scene_string(const std::string& yaml_text, const std::string& fi
   return Reader(file_name_for_messages).read(yaml_text);
 }
 
-fsi::Scene read_scene_file(const std::string& path) {
+fsi::Scene read_scene_file(const std::string& path, const std::string& relative_to) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))
     throw SceneError(path + ":1:1: error: this is a directory, not a scene file");
@@ -722,7 +925,7 @@ fsi::Scene read_scene_file(const std::string& path) {
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw SceneError(path + ":1:1: error: cannot read the scene file");
-  return read_scene_string(text.str(), path);
+  return Reader(path, relative_to).read(text.str());
 }
 
 }  // namespace turbid::tools

@@ -19,7 +19,10 @@ struct SceneError : std::runtime_error {
 // Reads and checks a scene file. Throws SceneError for a missing or unreadable file, a YAML syntax
 // error, a schema error (unknown or missing key, wrong type, value out of range) or a semantic error
 // (unknown material, overlapping regions, ...). Fills Scene::source_file and every `where`.
-fsi::Scene read_scene_file(const std::string& path);
+// Relative mesh paths are resolved against `relative_to` when given (a resumed run reads the scene
+// copied into its run directory, but the meshes stay beside the original scene), else against the
+// scene file's directory.
+fsi::Scene read_scene_file(const std::string& path, const std::string& relative_to = {});
 
 // The same for YAML text held in memory; `file_name_for_messages` is used in error messages and as
 // Scene::source_file.

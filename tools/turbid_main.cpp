@@ -98,7 +98,9 @@ int main(int argc, char** argv) {
                 report.at("particle_steps_per_second").get<double>(),
                 static_cast<unsigned long long>(report.at("removed_particles").get<std::uint64_t>()));
     const bool vtk = std::filesystem::exists(std::filesystem::path(dir) / "particles.pvd");
-    std::printf("results in %s: %sprobes.csv, run.json\n", dir.c_str(), vtk ? "particles.pvd (open in ParaView), " : "");
+    const bool forces = std::filesystem::exists(std::filesystem::path(dir) / "forces.csv");
+    std::printf("results in %s: %sprobes.csv, %srun.json\n", dir.c_str(), vtk ? "particles.pvd (open in ParaView), " : "",
+                forces ? "forces.csv (tools/plot_forces draws it), " : "");
     return 0;
   } catch (const turbid::tools::SceneError& e) {
     std::fprintf(stderr, "%s\n", e.what());

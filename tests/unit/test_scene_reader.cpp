@@ -110,8 +110,13 @@ const BadScene kBadScenes[] = {
      "an empty value is located at its key (yaml-cpp marks it at the next line)"},
     {"point_for_max_speed.yaml", 11, 35, "'point' does not apply to a 'max_speed' probe",
      "a key that belongs to another probe type"},
-    {"structures.yaml", 10, 1, "'structures' are not supported by the scene reader yet",
-     "a planned section is refused clearly"},
+    {"structures.yaml", 11, 31, "mesh file 'meshes/pipe.stl' not found",
+     "a missing mesh file is reported at its name, with where it was looked for"},
+    {"structure_two_shapes.yaml", 11, 18, "has both 'box' and 'sphere'", "a structure with two shapes"},
+    {"structure_no_lift_3d.yaml", 13, 19, "needs 'lift_direction'",
+     "3D coefficients without a lift direction (2D takes the in-plane normal)"},
+    {"inlet_too_thin.yaml", 11, 34, "less than the kernel support 2h = 0.04 m", "an inlet zone thinner than 2h"},
+    {"outlet_velocity.yaml", 11, 84, "'velocity' applies only to an inlet", "an option of inlets given to an outlet"},
 };
 
 class SceneReaderBadFile : public ::testing::TestWithParam<BadScene> {};

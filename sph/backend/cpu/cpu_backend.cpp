@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "sph/backend.hpp"
+#include "sph/boundary_passes.hpp"
 #include "sph/dispatch.hpp"
 #include "sph/passes.hpp"
 
@@ -76,6 +77,12 @@ class CpuBackend final : public Backend {
     else drift_impl<3>(Real(dt));
   }
 
+  OpenBoundaryCounts update_open_boundaries() override {
+    const OpenBoundaryCounts c = sph::update_open_boundaries(*store_, ids_, params_);
+    list_valid_ = false;  // indices may have changed; the next sort rebuilds everything
+    return c;
+  }
+
   StepStats stats() override { return params_.dimensions == 2 ? stats_impl<2>() : stats_impl<3>(); }
 
   std::optional<HealthIssue> check_health(double limit) override {
@@ -98,6 +105,18 @@ class CpuBackend final : public Backend {
 
   std::size_t pair_count() override { return params_.dimensions == 2 ? count_pairs<2>() : count_pairs<3>(); }
 
+  std::vector<BodyLoad> body_loads(const std::vector<std::array<double, 3>>& reference) override {
+    if (params_.body_count == 0 || ids_.structure_force < 0) return std::vector<BodyLoad>(reference.size());
+    if (params_.dimensions == 2) return loads_impl<2>(reference);
+    return loads_impl<3>(reference);
+  }
+
+  template <int D>
+  std::vector<BodyLoad> loads_impl(const std::vector<std::array<double, 3>>& reference) {
+    const ParticleView<D> P = view<D>();
+    return sum_body_loads<D>(P.position, P.structure_force, P.body, P.count, reference);
+  }
+
  private:
   double max_h_ratio() const {
     // Largest h present relative to the initial h; splitting only halves h, so 1 for now.
@@ -119,6 +138,10 @@ class CpuBackend final : public Backend {
     v.material = s.data<std::uint8_t>(ids_.material);
     v.kind = s.data<std::uint8_t>(ids_.kind);
     if (ids_.density_gradient >= 0) v.density_gradient = s.data<Vec<D>>(ids_.density_gradient);
+    if (ids_.boundary_normal >= 0) v.boundary_normal = s.data<Vec<D>>(ids_.boundary_normal);
+    if (ids_.structure_force >= 0) v.structure_force = s.data<Vec<D>>(ids_.structure_force);
+    if (ids_.body >= 0) v.body = s.data<std::uint8_t>(ids_.body);
+    if (ids_.zone >= 0) v.zone = s.data<std::uint8_t>(ids_.zone);
     v.count = std::uint32_t(s.size());
     if (soa_valid_) {
       v.position_soa = soa_.data();
@@ -243,11 +266,15 @@ class CpuBackend final : public Backend {
   void compute_momentum() {
     const ParticleView<D> P = view<D>();
     const GridView<D> G = grid<D>();
-    parallel_for(P.count, PressurePass<D>{P, params_});
     dispatch_kernel<D>(params_, [&](auto kernel_tag, auto uniform_tag) {
       using K = typename decltype(kernel_tag)::type;
       constexpr bool U = decltype(uniform_tag)::value;
+      if (params_.boundary == Boundary::mdbc)
+        parallel_for(P.count, MdbcPass<D, K, U>{P, G, params_, params_.mdbc_no_slip});
+      if (params_.zone_count > 0) parallel_for(P.count, BufferPass<D, K, U>{P, G, params_});
+      parallel_for(P.count, PressurePass<D>{P, params_});
       parallel_for(P.count, MomentumPass<D, K, U>{P, G, params_, list(true)});
+      if (params_.body_count > 0) parallel_for(P.count, StructureForcePass<D, K, U>{P, G, params_});
     });
     list_valid_ = true;
   }

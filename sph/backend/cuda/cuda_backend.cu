@@ -24,6 +24,7 @@
 #include "sph/backend.hpp"
 #include "sph/backend/cuda/cuda_check.hpp"
 #include "sph/backend/cuda/device_buffer.hpp"
+#include "sph/boundary_passes.hpp"
 #include "sph/dispatch.hpp"
 #include "sph/passes.hpp"
 
@@ -241,6 +242,15 @@ class CudaBackend final : public Backend {
     else launch("DriftPass<3>", n_, DriftPass<3>{view<3>(), Real(dt), wall_rho0});
   }
 
+  // Conversions at open boundaries run on the host (few particles change; the store is copied
+  // both ways only in scenes with open boundaries).
+  OpenBoundaryCounts update_open_boundaries() override {
+    sync_to_host();
+    const OpenBoundaryCounts c = sph::update_open_boundaries(*store_, ids_, params_);
+    sync_from_host();
+    return c;
+  }
+
   StepStats stats() override { return params_.dimensions == 2 ? stats_impl<2>() : stats_impl<3>(); }
 
   std::optional<HealthIssue> check_health(double limit) override {
@@ -267,6 +277,26 @@ class CudaBackend final : public Backend {
   }
 
   std::size_t pair_count() override { return params_.dimensions == 2 ? count_pairs<2>() : count_pairs<3>(); }
+
+  // The per-particle forces are summed on the host (few structure particles; double precision).
+  std::vector<BodyLoad> body_loads(const std::vector<std::array<double, 3>>& reference) override {
+    if (params_.body_count == 0 || ids_.structure_force < 0) return std::vector<BodyLoad>(reference.size());
+    if (params_.dimensions == 2) return loads_impl<2>(reference);
+    return loads_impl<3>(reference);
+  }
+
+  template <int D>
+  std::vector<BodyLoad> loads_impl(const std::vector<std::array<double, 3>>& reference) {
+    std::vector<Vec<D>> x(n_), f(n_);
+    std::vector<std::uint8_t> body(n_);
+    auto copy = [&](void* dst, FieldId id, std::size_t bytes) {
+      if (bytes > 0) TURBID_CUDA_CHECK(cudaMemcpy(dst, fields_[std::size_t(id)].get(), bytes, cudaMemcpyDeviceToHost));
+    };
+    copy(x.data(), ids_.position, n_ * sizeof(Vec<D>));
+    copy(f.data(), ids_.structure_force, n_ * sizeof(Vec<D>));
+    copy(body.data(), ids_.body, n_);
+    return sum_body_loads<D>(x.data(), f.data(), body.data(), n_, reference);
+  }
 
  private:
   double max_h_ratio() const {
@@ -331,6 +361,10 @@ class CudaBackend final : public Backend {
     v.material = static_cast<std::uint8_t*>(field(ids_.material));
     v.kind = static_cast<std::uint8_t*>(field(ids_.kind));
     if (ids_.density_gradient >= 0) v.density_gradient = static_cast<Vec<D>*>(field(ids_.density_gradient));
+    if (ids_.boundary_normal >= 0) v.boundary_normal = static_cast<Vec<D>*>(field(ids_.boundary_normal));
+    if (ids_.structure_force >= 0) v.structure_force = static_cast<Vec<D>*>(field(ids_.structure_force));
+    if (ids_.body >= 0) v.body = static_cast<std::uint8_t*>(field(ids_.body));
+    if (ids_.zone >= 0) v.zone = static_cast<std::uint8_t*>(field(ids_.zone));
     v.count = n_;
     return v;
   }
@@ -415,11 +449,15 @@ class CudaBackend final : public Backend {
   void compute_momentum() {
     const ParticleView<D> P = view<D>();
     const GridView<D> G = grid<D>();
-    launch("PressurePass", P.count, PressurePass<D>{P, params_});
     dispatch_kernel<D>(params_, [&](auto kernel_tag, auto uniform_tag) {
       using K = typename decltype(kernel_tag)::type;
       constexpr bool U = decltype(uniform_tag)::value;
+      if (params_.boundary == Boundary::mdbc)
+        launch("MdbcPass", P.count, MdbcPass<D, K, U>{P, G, params_, params_.mdbc_no_slip});
+      if (params_.zone_count > 0) launch("BufferPass", P.count, BufferPass<D, K, U>{P, G, params_});
+      launch("PressurePass", P.count, PressurePass<D>{P, params_});
       launch("MomentumPass", P.count, MomentumPass<D, K, U>{P, G, params_, NeighbourList{}});
+      if (params_.body_count > 0) launch("StructureForcePass", P.count, StructureForcePass<D, K, U>{P, G, params_});
     });
   }
 

@@ -1,0 +1,217 @@
+// Passes over boundary particles (walls and structures), shared by all backends:
+//  - MdbcPass: the modified dynamic boundary condition (English et al. 2022, physics.md C5);
+//  - StructureForcePass: the force of the fluid on each structure particle, the exact reaction of
+//    the momentum pass's pair terms.
+#pragma once
+#include <cmath>
+#include <cstdint>
+
+#include "sph/config.hpp"
+#include "sph/passes.hpp"
+
+namespace turbid::sph {
+
+// Solves the N x N system A x = b in place by Gaussian elimination with partial pivoting; returns
+// the determinant of A (0 if a pivot vanishes, x then undefined).
+template <int N>
+TURBID_HD inline Real solve_small(Real (&A)[N][N], Real (&b)[N], Real (&x)[N]) {
+  Real det = 1;
+  for (int c = 0; c < N; ++c) {
+    int p = c;
+    for (int r = c + 1; r < N; ++r)
+      if (std::fabs(A[r][c]) > std::fabs(A[p][c])) p = r;
+    if (A[p][c] == Real(0)) return Real(0);
+    if (p != c) {
+      for (int k = 0; k < N; ++k) {
+        const Real t = A[c][k];
+        A[c][k] = A[p][k];
+        A[p][k] = t;
+      }
+      const Real t = b[c];
+      b[c] = b[p];
+      b[p] = t;
+      det = -det;
+    }
+    det *= A[c][c];
+    for (int r = c + 1; r < N; ++r) {
+      const Real f = A[r][c] / A[c][c];
+      for (int k = c; k < N; ++k) A[r][k] -= f * A[c][k];
+      b[r] -= f * b[c];
+    }
+  }
+  for (int r = N - 1; r >= 0; --r) {
+    Real s = b[r];
+    for (int k = r + 1; k < N; ++k) s -= A[r][k] * x[k];
+    x[r] = s / A[r][r];
+  }
+  return det;
+}
+
+// First-order corrected SPH interpolation at a ghost node x_g over the fluid (physics.md C5):
+//   [ sum W V        sum x_jg^T W V        ] [ rho_g      ]   [ sum m W      ]
+//   [ sum grad W V   sum grad W (x) x_jg V ] [ grad rho_g ] = [ sum m grad W ]
+// `density` gets rho_g + (x_b - x_g) . grad rho_g with offset = x_g - x_b; where |det| < 1e-3
+// (too few neighbours on one side) the Shepard value sum m W / sum V W. `velocity` gets the
+// Shepard-interpolated fluid velocity at x_g. Returns false if no fluid is in reach (nothing set).
+template <int D, class K, bool UniformH>
+TURBID_HD inline bool ghost_interpolation(const ParticleView<D>& P, const GridView<D>& G, const PhysicsParams& prm,
+                                          const Vec<D>& xg, const Vec<D>& offset, Real h_b, Real& density,
+                                          Vec<D>& velocity) {
+  int c[D] = {};
+  if (!G.cell_of(xg, c) || !G.fluid_near(c)) return false;
+  const Real support2 = Real(4) * prm.max_smoothing_length * prm.max_smoothing_length;
+  constexpr int N = D + 1;
+  Real A[N][N] = {};
+  Real rhs[N] = {};
+  Vec<D> vsum = Vec<D>::zero();
+  G.for_each_neighbour_range(c, [&](std::uint32_t j0, std::uint32_t j1) {
+    for (std::uint32_t j = j0; j < j1; ++j) {
+      if (P.kind[j] != std::uint8_t(Kind::fluid)) continue;
+      const Vec<D> r = xg - P.position[j];  // x_g - x_j = -x_jg
+      const Real r2 = norm2(r);
+      if (r2 >= support2) continue;
+      const Real h = UniformH ? prm.smoothing_length : Real(0.5) * (h_b + P.smoothing_length[j]);
+      if (!UniformH && r2 >= Real(4) * h * h) continue;
+      const Real rr = std::sqrt(r2);
+      const Real W = K::w(rr, h);
+      const Real F = K::f_inv(rr, Real(1) / h);  // grad_g W_gj = F r
+      const Real m = P.mass[j];
+      const Real V = m / P.density[j];
+      A[0][0] += W * V;
+      rhs[0] += m * W;
+      for (int a = 0; a < D; ++a) {
+        A[0][1 + a] -= r[a] * W * V;
+        A[1 + a][0] += F * r[a] * V;
+        rhs[1 + a] += m * F * r[a];
+        for (int k = 0; k < D; ++k) A[1 + a][1 + k] -= F * r[a] * r[k] * V;
+      }
+      vsum += (W * V) * P.velocity[j];
+    }
+  });
+  const Real shepard = A[0][0];
+  if (!(shepard > Real(0))) return false;
+  const Real shepard_density = rhs[0] / shepard;
+  Real x[N] = {};
+  const Real det = solve_small<N>(A, rhs, x);
+  if (std::fabs(det) >= Real(1e-3)) {
+    density = x[0];
+    for (int a = 0; a < D; ++a) density -= offset[a] * x[1 + a];  // (x_b - x_g) . grad rho_g
+  } else {
+    density = shepard_density;
+  }
+  velocity = (Real(1) / shepard) * vsum;
+  return true;
+}
+
+// mDBC (English et al. 2022, physics.md C5) for walls and structures. Each boundary particle b
+// has a ghost node x_g = x_b + n_b mirrored across the wall surface into the fluid; its density is
+// the fluid's extrapolated from there (ghost_interpolation); with no fluid near, rest density.
+// Like our DBC walls, rho_b never falls below rest density: a wall that pulls fluid towards it
+// would let it through (and a free surface over a wall would stick to it).
+// No-slip: the particle's velocity becomes 2 v_wall - v~_g, v~_g the fluid velocity at the ghost
+// node, so that the velocity the viscous terms see goes through v_wall at the wall surface
+// (English et al. 2022; Adami et al. 2012, C6). Fixed walls: v_wall = 0.
+template <int D, class K, bool UniformH>
+struct MdbcPass {
+  ParticleView<D> P;
+  GridView<D> G;
+  PhysicsParams prm;
+  bool no_slip = true;
+
+  TURBID_HD void operator()(std::uint32_t b) const {
+    const std::uint8_t kind = P.kind[b];
+    if (kind != std::uint8_t(Kind::wall) && kind != std::uint8_t(Kind::structure)) return;
+    const Real rho0 = prm.materials[prm.wall_material].eos.rest_density;
+    const Vec<D> n = P.boundary_normal[b];
+    const Real h_b = UniformH ? prm.smoothing_length : P.smoothing_length[b];
+    Real rho = rho0;
+    Vec<D> v_ghost = Vec<D>::zero();
+    if (norm2(n) > Real(0)) ghost_interpolation<D, K, UniformH>(P, G, prm, P.position[b] + n, n, h_b, rho, v_ghost);
+    P.density[b] = rho > rho0 ? rho : rho0;
+    if (no_slip) P.velocity[b] = Real(-1) * v_ghost;
+  }
+};
+
+// Velocity an inlet prescribes at x: along the zone's axis, uniform or parabolic across the
+// zone's transverse extent (4 s (1 - s) per transverse axis, scaled so that the mean over the
+// cross-section is the zone's velocity: x 3/2 in 2D, x 9/4 in 3D).
+template <int D>
+TURBID_HD inline Vec<D> zone_velocity(const BufferZone& z, const Vec<D>& x) {
+  Real u = z.velocity;
+  if (z.profile == Profile::parabolic) {
+    for (int a = 0; a < D; ++a) {
+      if (a == z.axis) continue;
+      Real s = (x[a] - z.lo[a]) / (z.hi[a] - z.lo[a]);
+      s = s < Real(0) ? Real(0) : (s > Real(1) ? Real(1) : s);
+      u *= Real(6) * s * (Real(1) - s);  // 4 s (1 - s) / (2/3)
+    }
+  }
+  Vec<D> v = Vec<D>::zero();
+  v[z.axis] = z.sign * u;
+  return v;
+}
+
+// Buffer particles of open boundaries (see BufferZone): ghost = the particle mirrored across the
+// zone's plane. Inlet: prescribed velocity, density extrapolated from the fluid (rest density
+// when no fluid is near). Outlet: rest density, the fluid's velocity at the ghost (unchanged when
+// no fluid is near).
+template <int D, class K, bool UniformH>
+struct BufferPass {
+  ParticleView<D> P;
+  GridView<D> G;
+  PhysicsParams prm;
+
+  TURBID_HD void operator()(std::uint32_t b) const {
+    if (P.kind[b] != std::uint8_t(Kind::buffer)) return;
+    const BufferZone& z = prm.zones[P.zone[b]];
+    const Real rho0 = prm.materials[z.material].eos.rest_density;
+    const Vec<D> xb = P.position[b];
+    Vec<D> n = Vec<D>::zero();
+    n[z.axis] = Real(2) * (z.plane - xb[z.axis]);
+    const Real h_b = UniformH ? prm.smoothing_length : P.smoothing_length[b];
+    Real rho = rho0;
+    Vec<D> v_ghost = P.velocity[b];
+    const bool found = ghost_interpolation<D, K, UniformH>(P, G, prm, xb + n, n, h_b, rho, v_ghost);
+    if (z.type == ZoneType::inlet) {
+      P.density[b] = found ? rho : rho0;
+      P.velocity[b] = zone_velocity<D>(z, xb);
+    } else {
+      P.density[b] = rho0;
+      P.velocity[b] = v_ghost;
+    }
+  }
+};
+
+// Force of the fluid on every structure particle b: minus the sum over fluid neighbours i of
+// m_i times the acceleration the momentum pass gives i because of b (momentum_pair, the same
+// function with the same arguments), so the forces on structures and fluid cancel to rounding.
+template <int D, class K, bool UniformH>
+struct StructureForcePass {
+  ParticleView<D> P;
+  GridView<D> G;
+  PhysicsParams prm;
+
+  TURBID_HD void operator()(std::uint32_t b) const {
+    Vec<D> f = Vec<D>::zero();
+    if (P.kind[b] != std::uint8_t(Kind::structure)) {
+      P.structure_force[b] = f;
+      return;
+    }
+    const Vec<D> xb = P.position[b];
+    int c[D] = {};
+    if (G.cell_of(xb, c) && G.fluid_near(c)) {
+      for_each_neighbour<D>(P, G, NeighbourList{}, prm, b, xb, [&](std::uint32_t i, const Vec<D>& rbi, Real r2) {
+        if (P.kind[i] != std::uint8_t(Kind::fluid)) return;
+        const Real h_i = UniformH ? prm.smoothing_length : P.smoothing_length[i];
+        const MaterialParams& Mi = prm.materials[P.material[i]];
+        const Vec<D> rib = Real(-1) * rbi;
+        const Vec<D> a = momentum_pair<D, K, UniformH>(P, prm, P.velocity[i], P.density[i], P.pressure[i], h_i, Mi, b,
+                                                       rib, r2);
+        f -= P.mass[i] * a;
+      });
+    }
+    P.structure_force[b] = f;
+  }
+};
+
+}  // namespace turbid::sph
