@@ -108,9 +108,11 @@ TURBID_HD inline bool ghost_interpolation(const ParticleView<D>& P, const GridVi
 // the fluid's extrapolated from there (ghost_interpolation); with no fluid near, rest density.
 // Like our DBC walls, rho_b never falls below rest density: a wall that pulls fluid towards it
 // would let it through (and a free surface over a wall would stick to it).
-// No-slip: the particle's velocity becomes 2 v_wall - v~_g, v~_g the fluid velocity at the ghost
-// node, so that the velocity the viscous terms see goes through v_wall at the wall surface
-// (English et al. 2022; Adami et al. 2012, C6). Fixed walls: v_wall = 0.
+// No-slip: the velocity the viscous terms see at the particle (field viscous_velocity) becomes
+// 2 v_wall - v~_g, v~_g the fluid velocity at the ghost node, so that it goes through v_wall at the
+// wall surface (English et al. 2022; Adami et al. 2012, C6); continuity keeps the wall's own
+// velocity (mirroring the normal component there doubled the compression in front of a cylinder
+// and let fluid through). Fixed walls: v_wall = 0.
 template <int D, class K, bool UniformH>
 struct MdbcPass {
   ParticleView<D> P;
@@ -128,7 +130,7 @@ struct MdbcPass {
     Vec<D> v_ghost = Vec<D>::zero();
     if (norm2(n) > Real(0)) ghost_interpolation<D, K, UniformH>(P, G, prm, P.position[b] + n, n, h_b, rho, v_ghost);
     P.density[b] = rho > rho0 ? rho : rho0;
-    if (no_slip) P.velocity[b] = Real(-1) * v_ghost;
+    if (no_slip) P.viscous_velocity[b] = Real(-1) * v_ghost;
   }
 };
 

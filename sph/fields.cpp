@@ -28,6 +28,9 @@ FieldIds register_fields(ParticleStore& s, const PhysicsParams& p, bool structur
   // outward normal (zero for fluid).
   if (p.boundary == Boundary::mdbc)
     f.boundary_normal = s.add_field({"boundary_normal", "m", ScalarType::f32, d, true, true, true, Carry::copy});
+  // Recomputed by the mDBC pass after every sort, before the momentum pass reads it.
+  if (p.boundary == Boundary::mdbc && p.mdbc_no_slip)
+    f.viscous_velocity = s.add_field({"viscous_velocity", "m/s", ScalarType::f32, d, false, false, false, Carry::recompute});
   if (structures) {
     const char* force_unit = d == 2 ? "N/m" : "N";
     f.body = s.add_field({"body", "", ScalarType::u8, 1, true, true, true, Carry::copy});

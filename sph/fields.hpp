@@ -11,6 +11,7 @@ struct FieldIds {
   FieldId mass = -1, smoothing_length = -1, material = -1, kind = -1, id = -1;
   FieldId density_gradient = -1;  // registered only for Antuono diffusion
   FieldId boundary_normal = -1;   // registered only for mDBC
+  FieldId viscous_velocity = -1;  // registered only for no-slip mDBC
   FieldId body = -1, structure_force = -1;  // registered only when the scene has structures
   FieldId zone = -1;                        // registered only with open boundaries
 };

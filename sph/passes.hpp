@@ -35,6 +35,7 @@ struct ParticleView {
   Vec<D>* structure_force = nullptr;   // only with structures: force of the fluid on each structure particle
   std::uint8_t* body = nullptr;        // only with structures: structure index (kNoBody for others)
   std::uint8_t* zone = nullptr;        // only with open boundaries: buffer zone index (kNoZone for others)
+  Vec<D>* viscous_velocity = nullptr;  // only with no-slip mDBC: the velocity walls show the viscous terms
   // CPU only: positions as one array per coordinate (component a at a * soa_stride), a copy made
   // at each sort so that distance checks vectorise; valid until the next drift.
   const Real* position_soa = nullptr;
@@ -442,7 +443,10 @@ TURBID_HD inline Vec<D> momentum_pair(const ParticleView<D>& P, const PhysicsPar
   const Real m_j = P.mass[j];
   const std::uint8_t mat_j = P.kind[j] == std::uint8_t(Kind::fluid) ? P.material[j] : std::uint8_t(prm.wall_material);
   const MaterialParams& Mj = prm.materials[mat_j];
-  const Vec<D> vij = vi - P.velocity[j];
+  // No-slip mDBC: a boundary particle shows the viscous terms the mirrored fluid velocity.
+  const bool mirrored = P.viscous_velocity != nullptr &&
+                        (P.kind[j] == std::uint8_t(Kind::wall) || P.kind[j] == std::uint8_t(Kind::structure));
+  const Vec<D> vij = vi - (mirrored ? P.viscous_velocity[j] : P.velocity[j]);
   const Real eta2 = kEta2Factor * h * h;
   Real s = pair::pressure(m_j, p_i, P.pressure[j], rho_i, rho_j, F);
   if (prm.viscosity == Viscosity::artificial) {
@@ -477,7 +481,7 @@ struct MomentumPass {
     const bool artificial = prm.viscosity == Viscosity::artificial;
 #if !defined(__CUDA_ARCH__)
     if constexpr (UniformH) {
-      if (artificial && lanes(i, xi, vi, rho_i, p_i, Mi, acc)) {
+      if (artificial && P.viscous_velocity == nullptr && lanes(i, xi, vi, rho_i, p_i, Mi, acc)) {
         for (int k = 0; k < D; ++k) acc[k] += prm.gravity[k];
         P.acceleration[i] = acc;
         return;

@@ -156,11 +156,12 @@ std::string describe_scene(const fsi::Scene& scene) {
   fsi::Simulation sim(scene, opts);
   const auto& s = sim.summary();
   std::ostringstream os;
-  const std::size_t total = s.fluid_particles + s.wall_particles + s.structure_particles;
+  const std::size_t total = s.fluid_particles + s.wall_particles + s.structure_particles + s.buffer_particles;
   os << "scene            " << scene.name << " (" << scene.dimensions << "D)\n";
   os << "spacing          " << scene.particle_spacing << " m, h = " << s.smoothing_length << " m\n";
   os << "particles        " << total << " (fluid " << s.fluid_particles << ", wall " << s.wall_particles;
   if (s.structure_particles > 0) os << ", structure " << s.structure_particles;
+  if (s.buffer_particles > 0) os << ", open-boundary buffer " << s.buffer_particles;
   os << ")\n";
   os << "wall treatment   "
      << (scene.numerics.boundary == fsi::BoundaryKind::mdbc
@@ -172,6 +173,12 @@ std::string describe_scene(const fsi::Scene& scene) {
     os << "  structure " << st.name << ": " << st.particles << " particles, surface "
        << st.surface_area << (two_d ? " m (perimeter)" : " m^2") << ", volume " << st.volume
        << (two_d ? " m^2 (area)" : " m^3") << "\n";
+  for (const auto& ob : scene.open_boundaries)
+    os << "  " << (ob.inlet ? "inlet " : "outlet ") << ob.name << ": flow along "
+       << (ob.velocity.sign > 0 ? "+" : "-") << "xyz"[ob.velocity.axis]
+       << (ob.inlet ? (ob.velocity.parabolic ? ", parabolic profile, mean " : ", uniform ") : "")
+       << (ob.inlet ? std::to_string(ob.velocity.mean) + " m/s" : std::string(", pressure = background pressure"))
+       << "\n";
   if (s.fluid_removed_by_structures > 0)
     os << "  fluid lattice points left out inside structures: " << s.fluid_removed_by_structures << "\n";
   for (std::size_t m = 0; m < scene.materials.size(); ++m)

@@ -421,10 +421,12 @@ fsi::Scene Reader::read(const std::string& yaml_text) {
   fsi::Scene scene;
   scene.source_file = file_;
   {
+    // absolute() of the file first: a bare "scene.yaml" has an empty parent path.
     std::error_code ec;
-    const std::filesystem::path base =
-        relative_to_.empty() ? std::filesystem::path(file_).parent_path() : std::filesystem::path(relative_to_);
-    scene.base_directory = std::filesystem::absolute(base, ec).lexically_normal().string();
+    const std::filesystem::path base = relative_to_.empty()
+                                           ? std::filesystem::absolute(file_, ec).parent_path()
+                                           : std::filesystem::absolute(relative_to_, ec);
+    scene.base_directory = base.lexically_normal().string();
   }
   try {
     const YAML::Node& doc = documents[0];

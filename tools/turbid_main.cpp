@@ -106,7 +106,13 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", e.what());
     return 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "turbid: error: %s\n", e.what());
+    // Messages that already start with FILE:LINE:COL: error: stay at the start of the line, where
+    // editors and log matchers look for them.
+    const std::string what = e.what();
+    if (what.find(": error: ") != std::string::npos && what.find(": error: ") < what.find(' '))
+      std::fprintf(stderr, "%s\n", what.c_str());
+    else
+      std::fprintf(stderr, "turbid: error: %s\n", what.c_str());
     return 1;
   }
 }

@@ -9,6 +9,10 @@ step when a definition changes.
   hydrostatic_tank_2d  largest relative error |p - rho0 g (H - y)| / (rho0 g (H - y)) of the
                        pressure probes at the end of the run; also the largest max_speed over
                        sqrt(g H).
+  cylinder_2d_re20     relative error of C_D (forces.csv, mean over t >= 2.5 s) against
+                       Schaefer & Turek's 5.5795; also the mean C_L.
+  buoyancy_2d          largest relative error of the mean vertical force (t >= 1 s) on the box
+                       and the cylinder against rho0 g V.
 
 Run as a script, it plots the dam-break front of one or more runs against the experiment:
 
@@ -174,7 +178,45 @@ def hydrostatic_errors(run_dir):
 # ---------------------------------------------------------------------------------------------
 # Metric by scene name (tools/convergence)
 
+# Schaefer & Turek (1996) 2D-1 (../shared/reference/data/dfg_cylinder_reference_values.csv).
+DFG_CD = 5.57953523384
+DFG_FROM = 2.5  # s: the wake has formed
+
+
+def forces_mean(run_dir, column, t_from):
+    f = read_csv(os.path.join(run_dir, "forces.csv"))
+    t = f["time [s]"]
+    vals = [v for tt, v in zip(t, f[column]) if tt >= t_from]
+    if not vals:
+        raise ValueError(f"{run_dir}: no forces.csv rows after t = {t_from} s")
+    return sum(vals) / len(vals)
+
+
+def dfg_error(run_dir):
+    return abs(forces_mean(run_dir, "cylinder.C_D [-]", DFG_FROM) - DFG_CD) / DFG_CD
+
+
+def buoyancy_error(run_dir):
+    volumes = {"box": 0.2 * 0.2, "cylinder": math.pi * 0.1 * 0.1}
+    worst = 0.0
+    for name, v in volumes.items():
+        expected = HYDROSTATIC_DENSITY * GRAVITY * v
+        worst = max(worst, abs(forces_mean(run_dir, f"{name}.Fy [N/m]", 1.0) - expected) / expected)
+    return worst
+
+
 METRICS = {
+    "cylinder_2d_re20": {
+        "description": "relative C_D error vs Schaefer & Turek 2D-1 (5.5795), mean over t >= 2.5 s",
+        "error": dfg_error,
+        "extra": {"C_D": lambda d: forces_mean(d, "cylinder.C_D [-]", DFG_FROM),
+                  "C_L": lambda d: forces_mean(d, "cylinder.C_L [-]", DFG_FROM)},
+    },
+    "buoyancy_2d": {
+        "description": "largest relative error of the mean F_y (t >= 1 s) vs rho0 g V (box, cylinder)",
+        "error": buoyancy_error,
+        "extra": {},
+    },
     "dam_break_2d": {
         "description": "RMS relative surge-front error vs Martin & Moyce 1952, T <= 3 (front + dx/2)",
         "error": dam_break_error,

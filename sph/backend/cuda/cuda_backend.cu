@@ -365,6 +365,7 @@ class CudaBackend final : public Backend {
     if (ids_.structure_force >= 0) v.structure_force = static_cast<Vec<D>*>(field(ids_.structure_force));
     if (ids_.body >= 0) v.body = static_cast<std::uint8_t*>(field(ids_.body));
     if (ids_.zone >= 0) v.zone = static_cast<std::uint8_t*>(field(ids_.zone));
+    if (ids_.viscous_velocity >= 0) v.viscous_velocity = static_cast<Vec<D>*>(field(ids_.viscous_velocity));
     v.count = n_;
     return v;
   }
