@@ -5,10 +5,10 @@
 // Reference: C_D = 5.5795 (../shared/reference/data/dfg_cylinder_reference_values.csv; bounds of
 // the 1996 paper 5.57-5.59), C_D = 2 F_D / (rho U_mean^2 D).
 // Quick mode (CI): D/dx = 10 (dx = 0.01 m), to t = 4 s, C_D averaged over 2.5 s <= t <= 4 s (the
-// wake has formed after ~2 s; the mean then varies by less than 1% between windows). Measured:
-// +0.6%. Tolerance 3%: the scatter of this mean between D/dx = 8 and 15 in the convergence table of
-// docs/validation.md. Full mode (TURBID_FULL=1): D/dx = 20 to t = 5 s, tolerance 5% (issue #4's
-// bound at the finest documented spacing).
+// wake has formed after ~2 s). Measured: C_D = 5.624, +0.8%. Tolerance 5%, the bound issue #4 sets
+// for the finest spacing: coarser runs are not monotone (docs/validation.md, D1 convergence: 8.5%
+// at D/dx = 5, 12.5% at D/dx = 8, 0.8% at 10, 0.14% at 15), so a tighter CI bound would test luck.
+// Full mode (TURBID_FULL=1): D/dx = 20 to t = 4 s, tolerance 5%.
 // Also checked: the run stays stable with open boundaries (no particle lost other than through the
 // outlet; as many particles enter as leave, within the count of one inlet layer) and no fluid
 // particle ever lies inside the cylinder.
@@ -29,9 +29,9 @@ using turbid::validation::read_csv;
 
 TEST(ValidationCylinderDfg, DragCoefficientMatchesSchaeferTurek2D1) {
   const double dx = full_mode() ? 0.005 : 0.01;
-  const double end = full_mode() ? 5.0 : 4.0;
+  const double end = 4.0;
   const double from = 2.5;
-  const double tolerance = full_mode() ? 0.05 : 0.03;
+  const double tolerance = 0.05;
   const double reference = 5.57953523384;
   const fs::path out = fs::temp_directory_path() / ("turbid_validation_dfg_" + std::to_string(::getpid()));
   fs::remove_all(out);
