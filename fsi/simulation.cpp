@@ -8,11 +8,13 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "fsi/probes.hpp"
 #include "geometry/mesh.hpp"
 #include "geometry/primitives.hpp"
 #include "geometry/shapes.hpp"
+#include "geometry/solid.hpp"
 #include "sph/boundary_passes.hpp"
 #include "sph/vec.hpp"
 
@@ -119,92 +121,60 @@ Point profile_velocity(const VelocityProfile& p, const Box& box, const Point& x,
   return v;
 }
 
-geometry::SampledBody sample_structure(const StructureSpec& st, double dx, int dims, int layers) {
+geometry::Placement placement_of(const StructureSpec& st) {
   geometry::Placement place;
   place.translation = st.position;
   place.rotation_deg = st.rotation_deg;
   place.scale = st.scale;
+  return place;
+}
+
+// `mesh`: the structure's mesh, loaded once by the caller (mesh structures only).
+geometry::SampledBody sample_structure(const StructureSpec& st, double dx, int dims, int layers,
+                                       const geometry::TriangleMesh* mesh = nullptr) {
+  const geometry::Placement place = placement_of(st);
   switch (st.shape) {
     case StructureSpec::Shape::box: return geometry::sample_box(st.size, dx, layers, dims, place);
     case StructureSpec::Shape::sphere: return geometry::sample_sphere(st.radius, dx, layers, dims, place);
     case StructureSpec::Shape::cylinder: return geometry::sample_cylinder(st.radius, st.length, dx, layers, dims, place);
-    case StructureSpec::Shape::mesh: return geometry::sample_mesh(geometry::load_mesh(st.resolved_file), dx, layers, dims, place);
+    case StructureSpec::Shape::mesh:
+      return geometry::sample_mesh(mesh ? *mesh : geometry::load_mesh(st.resolved_file), dx, layers, dims, place);
   }
   return {};
 }
 
+// The solid of a structure, for its exact signed distance (geometry/solid.hpp).
+geometry::Solid structure_solid(const StructureSpec& st, int dims, const geometry::TriangleMesh* mesh) {
+  const geometry::Placement place = placement_of(st);
+  switch (st.shape) {
+    case StructureSpec::Shape::box: return geometry::Solid::box(st.size, dims, place);
+    case StructureSpec::Shape::sphere: return geometry::Solid::sphere(st.radius, dims, place);
+    case StructureSpec::Shape::cylinder: return geometry::Solid::cylinder(st.radius, st.length, dims, place);
+    case StructureSpec::Shape::mesh:
+      return geometry::Solid::mesh(mesh ? *mesh : geometry::load_mesh(st.resolved_file), dims, place);
+  }
+  throw std::invalid_argument("unknown structure shape");
+}
+
 // Which fluid lattice points lie inside a structure or closer than half a spacing to its surface:
-// the signed distance of a point to the tangent plane at the surface point of its nearest
-// structure particle (x_b + depth_b n_b, normal n_b) decides. Deep inside a body with few layers
-// the nearest particle is one of the innermost layer, whose outward normal still gives a negative
-// distance.
+// a point is left out iff its exact signed distance to some structure's solid (negative inside) is
+// below dx/2 (1 - 1e-6). The distance is that of the shape itself (box, sphere, cylinder, the mesh's
+// triangles), so beyond convex edges and corners it is the distance to the edge or corner.
 class StructureCarver {
  public:
-  StructureCarver(const std::vector<geometry::SampledBody>& bodies, double dx) : dx_(dx), cell_(2.0 * dx) {
-    for (const auto& b : bodies)
-      for (std::size_t i = 0; i < b.points.size(); ++i) {
-        const Point s{b.points[i][0] + b.depth[i] * b.normals[i][0], b.points[i][1] + b.depth[i] * b.normals[i][1],
-                      b.points[i][2] + b.depth[i] * b.normals[i][2]};
-        pts_.push_back({b.points[i], s, b.normals[i]});
-        for (int k = 0; k < 3; ++k) {
-          lo_[k] = std::min(lo_[k], b.points[i][k] - dx);
-          hi_[k] = std::max(hi_[k], b.points[i][k] + dx);
-        }
-      }
-    if (pts_.empty()) return;
-    for (int k = 0; k < 3; ++k) n_[k] = std::max(1, int(std::ceil((hi_[k] - lo_[k]) / cell_)));
-    cells_.resize(std::size_t(n_[0]) * n_[1] * n_[2]);
-    for (std::size_t i = 0; i < pts_.size(); ++i) cells_[index(cell_of(pts_[i].x))].push_back(i);
-  }
+  StructureCarver(std::vector<geometry::Solid> solids, double dx) : solids_(std::move(solids)), dx_(dx) {}
 
   bool blocks(const Point& p) const {
-    if (pts_.empty()) return false;
-    for (int k = 0; k < 3; ++k)
-      if (p[k] < lo_[k] - dx_ || p[k] > hi_[k] + dx_) return false;
-    const auto c = cell_of(p);
-    const int max_ring = std::max({n_[0], n_[1], n_[2]});
-    double best = std::numeric_limits<double>::infinity();
-    std::size_t best_i = 0;
-    for (int ring = 0; ring <= max_ring; ++ring) {
-      // Every point in a later ring is at least (ring) cells away.
-      if (std::isfinite(best) && double(ring - 1) * cell_ > std::sqrt(best)) break;
-      for (int z = c[2] - ring; z <= c[2] + ring; ++z)
-        for (int y = c[1] - ring; y <= c[1] + ring; ++y)
-          for (int x = c[0] - ring; x <= c[0] + ring; ++x) {
-            if (std::max({std::abs(x - c[0]), std::abs(y - c[1]), std::abs(z - c[2])}) != ring) continue;
-            if (x < 0 || y < 0 || z < 0 || x >= n_[0] || y >= n_[1] || z >= n_[2]) continue;
-            for (std::size_t i : cells_[index({x, y, z})]) {
-              const Point d = sub(p, pts_[i].x);
-              const double r2 = dot3(d, d);
-              if (r2 < best) {
-                best = r2;
-                best_i = i;
-              }
-            }
-          }
-    }
-    if (!std::isfinite(best)) return false;
-    const Entry& e = pts_[best_i];
-    return dot3(sub(p, e.surface), e.normal) < 0.5 * dx_ * (1.0 - 1e-6);
+    const double limit = 0.5 * dx_ * (1.0 - 1e-6);
+    // Cut-off dx > limit: the early exits of the meshes still decide "< limit" exactly.
+    for (const auto& s : solids_)
+      if (s.signed_distance(p, dx_) < limit) return true;
+    return false;
   }
 
  private:
-  struct Entry {
-    Point x, surface, normal;
-  };
-  std::array<int, 3> cell_of(const Point& p) const {
-    std::array<int, 3> c{};
-    for (int k = 0; k < 3; ++k) c[k] = std::clamp(int((p[k] - lo_[k]) / cell_), 0, n_[k] - 1);
-    return c;
-  }
-  std::size_t index(const std::array<int, 3>& c) const {
-    return (std::size_t(c[2]) * std::size_t(n_[1]) + std::size_t(c[1])) * std::size_t(n_[0]) + std::size_t(c[0]);
-  }
-  double dx_, cell_;
-  double lo_[3] = {1e300, 1e300, 1e300}, hi_[3] = {-1e300, -1e300, -1e300};
-  int n_[3] = {1, 1, 1};
-  std::vector<Entry> pts_;
-  std::vector<std::vector<std::size_t>> cells_;
+  std::vector<geometry::Solid> solids_;
+  double dx_;
 };
 
 }  // namespace
@@ -337,10 +307,16 @@ void Simulation::build_particles() {
 
   // Structures are sampled first: fluid lattice points inside them are left out.
   std::vector<geometry::SampledBody> bodies;
+  std::vector<geometry::Solid> solids;
   for (const auto& st : s.structures) {
     const int layers = st.layers > 0 ? st.layers : std::max(1, int(std::ceil(2.0 * s.smoothing_ratio - 1e-9)));
     try {
-      bodies.push_back(sample_structure(st, dx, d, layers));
+      // A mesh file is read once, for the particles and the solid.
+      geometry::TriangleMesh mesh;
+      if (st.shape == StructureSpec::Shape::mesh) mesh = geometry::load_mesh(st.resolved_file);
+      const geometry::TriangleMesh* m = st.shape == StructureSpec::Shape::mesh ? &mesh : nullptr;
+      bodies.push_back(sample_structure(st, dx, d, layers, m));
+      solids.push_back(structure_solid(st, d, m));
     } catch (const std::exception& e) {
       std::ostringstream os;
       os << st.where.file << ":" << st.where.line << ":" << st.where.column << ": error: structure '" << st.name
@@ -359,7 +335,7 @@ void Simulation::build_particles() {
     if (st.shape != StructureSpec::Shape::mesh) volume = sample_structure(st, dx, d, 0).volume;
     summary_.structures.push_back({st.name, bodies.back().points.size(), bodies.back().surface_area, volume});
   }
-  const StructureCarver carver(bodies, dx);
+  const StructureCarver carver(std::move(solids), dx);
 
   for (const auto& f : s.fluids) {
     const std::uint8_t m = material_of(f.material, f.where);

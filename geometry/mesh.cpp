@@ -12,29 +12,18 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
-#include <limits>
 #include <unordered_map>
 #include <utility>
+
+#include "geometry/mesh_detail.hpp"
 
 namespace turbid::geometry {
 
 namespace {
 
-constexpr int kSub = 8;  // integration lines per cell and axis (8 x 8 in 3D, 8 in 2D)
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using namespace detail;
 
-Point sub(const Point& a, const Point& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Point add(const Point& a, const Point& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
-Point mul(const Point& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
-double dot(const Point& a, const Point& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-Point cross(const Point& a, const Point& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double norm(const Point& a) { return std::sqrt(dot(a, a)); }
-Point unit_or_zero(const Point& a) {
-  const double n = norm(a);
-  return n > 0 ? mul(a, 1.0 / n) : Point{0, 0, 0};
-}
+constexpr int kSub = 8;  // integration lines per cell and axis (8 x 8 in 3D, 8 in 2D)
 
 std::string fmt(double v) {
   char buf[32];
@@ -50,21 +39,6 @@ std::string fmt(const Point& p) {
 std::string capitalised(std::string s) {
   if (!s.empty() && s[0] >= 'a' && s[0] <= 'z') s[0] = char(s[0] - 'a' + 'A');
   return s;
-}
-
-std::uint64_t edge_key(int a, int b) {
-  const auto lo = std::uint64_t(std::uint32_t(std::min(a, b))), hi = std::uint64_t(std::uint32_t(std::max(a, b)));
-  return (lo << 32) | hi;
-}
-
-Aabb bounds(const std::vector<Point>& pts) {
-  Aabb b{{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}};
-  for (const auto& p : pts)
-    for (int k = 0; k < 3; ++k) {
-      b.min[k] = std::min(b.min[k], p[k]);
-      b.max[k] = std::max(b.max[k], p[k]);
-    }
-  return b;
 }
 
 // ---- vertex merging -------------------------------------------------------------------------
@@ -124,175 +98,6 @@ std::vector<int> merge_vertices(const std::vector<Point>& raw, double tol, std::
   return remap;
 }
 
-// ---- bounding-volume hierarchy for nearest-item queries --------------------------------------
-
-class Bvh {
- public:
-  // boxes[i] = {min, max} of item i.
-  explicit Bvh(const std::vector<std::array<Point, 2>>& boxes) : boxes_(boxes) {
-    order_.resize(boxes.size());
-    for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = int(i);
-    nodes_.reserve(2 * boxes.size() / kLeaf + 2);
-    if (!boxes.empty()) build(0, int(boxes.size()));
-  }
-
-  // The item minimising dist2(item) (a squared distance) among those with dist2 < best_d2; -1 if
-  // none. best_d2 is lowered to the distance found.
-  template <class F>
-  int nearest(const Point& p, double& best_d2, F&& dist2) const {
-    int best = -1;
-    if (nodes_.empty()) return best;
-    int stack[128];
-    int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-      const Node& n = nodes_[stack[--top]];
-      if (box_d2(n, p) >= best_d2) continue;
-      if (n.count > 0) {
-        for (int q = n.start; q < n.start + n.count; ++q) {
-          const double d2 = dist2(order_[q]);
-          if (d2 < best_d2) {
-            best_d2 = d2;
-            best = order_[q];
-          }
-        }
-        continue;
-      }
-      const int l = int(&n - nodes_.data()) + 1, r = n.right;
-      const double dl = box_d2(nodes_[l], p), dr = box_d2(nodes_[r], p);
-      // Nearer child popped first.
-      const int first = dl <= dr ? l : r, second = dl <= dr ? r : l;
-      const double d_first = std::min(dl, dr), d_second = std::max(dl, dr);
-      if (d_second < best_d2 && top < 127) stack[top++] = second;
-      if (d_first < best_d2 && top < 127) stack[top++] = first;
-    }
-    return best;
-  }
-
- private:
-  static constexpr int kLeaf = 4;
-  struct Node {
-    Point lo, hi;
-    int start = 0, count = 0;  // leaf: items order_[start, start + count)
-    int right = -1;            // internal: left child is the next node
-  };
-
-  static double box_d2(const Node& n, const Point& p) {
-    double d2 = 0;
-    for (int k = 0; k < 3; ++k) {
-      const double d = std::max({n.lo[k] - p[k], 0.0, p[k] - n.hi[k]});
-      d2 += d * d;
-    }
-    return d2;
-  }
-
-  int build(int start, int end) {
-    const int id = int(nodes_.size());
-    nodes_.push_back({});
-    Point lo{kInf, kInf, kInf}, hi{-kInf, -kInf, -kInf}, clo = lo, chi = hi;
-    for (int q = start; q < end; ++q) {
-      const auto& b = boxes_[order_[q]];
-      for (int k = 0; k < 3; ++k) {
-        lo[k] = std::min(lo[k], b[0][k]);
-        hi[k] = std::max(hi[k], b[1][k]);
-        const double c = 0.5 * (b[0][k] + b[1][k]);
-        clo[k] = std::min(clo[k], c);
-        chi[k] = std::max(chi[k], c);
-      }
-    }
-    nodes_[id].lo = lo;
-    nodes_[id].hi = hi;
-    if (end - start <= kLeaf) {
-      nodes_[id].start = start;
-      nodes_[id].count = end - start;
-      return id;
-    }
-    int axis = 0;
-    for (int k = 1; k < 3; ++k)
-      if (chi[k] - clo[k] > chi[axis] - clo[axis]) axis = k;
-    const int mid = (start + end) / 2;
-    std::nth_element(order_.begin() + start, order_.begin() + mid, order_.begin() + end, [&](int a, int b) {
-      return boxes_[a][0][axis] + boxes_[a][1][axis] < boxes_[b][0][axis] + boxes_[b][1][axis];
-    });
-    build(start, mid);
-    const int r = build(mid, end);
-    nodes_[id].right = r;
-    return id;
-  }
-
-  const std::vector<std::array<Point, 2>>& boxes_;
-  std::vector<int> order_;
-  std::vector<Node> nodes_;
-};
-
-// ---- closest points ---------------------------------------------------------------------------
-
-// Feature of a triangle (a, b, c) holding the closest point.
-enum Feature { kFace, kVertexA, kVertexB, kVertexC, kEdgeAB, kEdgeBC, kEdgeCA };
-
-Point closest_on_segment(const Point& p, const Point& a, const Point& b, double& t) {
-  const Point ab = sub(b, a);
-  const double l2 = dot(ab, ab);
-  t = l2 > 0 ? std::clamp(dot(sub(p, a), ab) / l2, 0.0, 1.0) : 0.0;
-  return add(a, mul(ab, t));
-}
-
-// Closest point of triangle (a, b, c) to p, by the Voronoi regions of its vertices, edges and face.
-Point closest_on_triangle(const Point& p, const Point& a, const Point& b, const Point& c, Feature& f) {
-  const Point ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
-  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
-  if (d1 <= 0 && d2 <= 0) {
-    f = kVertexA;
-    return a;
-  }
-  const Point bp = sub(p, b);
-  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) {
-    f = kVertexB;
-    return b;
-  }
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
-    f = kEdgeAB;
-    return add(a, mul(ab, d1 / (d1 - d3)));
-  }
-  const Point cp = sub(p, c);
-  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) {
-    f = kVertexC;
-    return c;
-  }
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
-    f = kEdgeCA;
-    return add(a, mul(ac, d2 / (d2 - d6)));
-  }
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
-    f = kEdgeBC;
-    return add(b, mul(sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6))));
-  }
-  const double denom = va + vb + vc;
-  if (denom > 0) {
-    f = kFace;
-    return add(a, add(mul(ab, vb / denom), mul(ac, vc / denom)));
-  }
-  // Degenerate (zero-area) triangle: the nearest of its edges.
-  double t;
-  Point best = closest_on_segment(p, a, b, t);
-  f = kEdgeAB;
-  const Point q1 = closest_on_segment(p, b, c, t), q2 = closest_on_segment(p, c, a, t);
-  if (dot(sub(q1, p), sub(q1, p)) < dot(sub(best, p), sub(best, p))) {
-    best = q1;
-    f = kEdgeBC;
-  }
-  if (dot(sub(q2, p), sub(q2, p)) < dot(sub(best, p), sub(best, p))) {
-    best = q2;
-    f = kEdgeCA;
-  }
-  return best;
-}
-
 // ---- lattice --------------------------------------------------------------------------------
 
 struct Lattice {
@@ -342,10 +147,6 @@ void add_interval(const Lattice& L, double a, double b, double weight, double* a
   }
 }
 
-struct Crossing {
-  double x;
-  int sign;  // +1 entering the solid along +x, -1 leaving
-};
 
 // Integrates the inside intervals of a sorted crossing list into acc.
 void integrate_line(const Lattice& L, const std::vector<Crossing>& cr, double weight, double* acc) {
@@ -474,51 +275,6 @@ SampledBody assemble(const Lattice& L, const std::vector<char>& inside, const st
 
 // ---- 3D ---------------------------------------------------------------------------------------
 
-// Sign (+1 left, -1 right) of (y0, z0) relative to the directed edge ia -> ib in the (y, z) plane,
-// evaluated from the lower vertex index so that both triangles sharing the edge get opposite signs
-// of the same number; exact zeros are resolved by perturbing the point by (eps, eps^2). `value`
-// receives the edge function itself (for barycentric weights). 0 only for an edge parallel to x.
-int edge_side(const std::vector<Point>& P, int ia, int ib, double y0, double z0, double& value) {
-  const bool flip = ia > ib;
-  const Point& a = P[flip ? ib : ia];
-  const Point& b = P[flip ? ia : ib];
-  const double uy = b[1] - a[1], uz = b[2] - a[2];
-  double e = uy * (z0 - a[2]) - uz * (y0 - a[1]);
-  int s = e > 0 ? 1 : (e < 0 ? -1 : (uz != 0 ? (uz > 0 ? -1 : 1) : (uy > 0 ? 1 : (uy < 0 ? -1 : 0))));
-  if (flip) {
-    e = -e;
-    s = -s;
-  }
-  value = e;
-  return s;
-}
-
-// Crossings of the line {y = y0, z = z0} with the triangles of one bucket, sorted by x.
-void line_crossings(const std::vector<Point>& P, const std::vector<std::array<int, 3>>& T, const int* tris,
-                    std::size_t count, double y0, double z0, std::vector<Crossing>& out) {
-  out.clear();
-  for (std::size_t q = 0; q < count; ++q) {
-    const auto& t = T[tris[q]];
-    double wc, wa, wb;  // edge functions opposite c, a, b
-    const int s0 = edge_side(P, t[0], t[1], y0, z0, wc);
-    if (s0 == 0) continue;
-    const int s1 = edge_side(P, t[1], t[2], y0, z0, wa);
-    if (s1 != s0) continue;
-    const int s2 = edge_side(P, t[2], t[0], y0, z0, wb);
-    if (s2 != s0) continue;
-    const double sum = wa + wb + wc;
-    double x;
-    if (sum != 0) {
-      x = (wa * P[t[0]][0] + wb * P[t[1]][0] + wc * P[t[2]][0]) / sum;
-    } else {
-      x = (P[t[0]][0] + P[t[1]][0] + P[t[2]][0]) / 3.0;  // not reached for a non-degenerate projection
-    }
-    // All edges to the left: counter-clockwise in (y, z), normal with +x component: leaving.
-    out.push_back({x, s0 > 0 ? -1 : 1});
-  }
-  std::sort(out.begin(), out.end(), [](const Crossing& a, const Crossing& b) { return a.x < b.x; });
-}
-
 SampledBody sample_solid(const std::vector<Point>& P, const std::vector<std::array<int, 3>>& T, double dx,
                          int layers) {
   const Lattice L = make_lattice(bounds(P), dx, 3);
@@ -603,7 +359,7 @@ SampledBody sample_solid(const std::vector<Point>& P, const std::vector<std::arr
       en = add(en, n);
     }
   }
-  const Bvh bvh(boxes);
+  const Bvh bvh(std::move(boxes));
 
   // Queries come in lattice order: the previous answer's triangle bounds the next search.
   int hint = -1;
@@ -671,63 +427,6 @@ SampledBody sample_solid(const std::vector<Point>& P, const std::vector<std::arr
 
 // ---- 2D ---------------------------------------------------------------------------------------
 
-// Closed polygons (outer boundaries counter-clockwise) of the section of the mesh by z = 0.
-std::vector<std::vector<Point>> cut_by_plane(const std::vector<Point>& P, const std::vector<std::array<int, 3>>& T) {
-  auto above = [&](int v) { return P[v][2] >= 0; };
-  std::unordered_map<std::uint64_t, int> point_of_edge;
-  std::vector<Point> pts;
-  auto crossing = [&](int a, int b) {
-    const std::uint64_t key = edge_key(a, b);
-    const auto it = point_of_edge.find(key);
-    if (it != point_of_edge.end()) return it->second;
-    const Point& p = P[std::min(a, b)];
-    const Point& q = P[std::max(a, b)];
-    const double t = p[2] / (p[2] - q[2]);
-    const int id = int(pts.size());
-    pts.push_back({p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1]), 0.0});
-    point_of_edge.emplace(key, id);
-    return id;
-  };
-  std::vector<int> next;  // next[point] = following point along the section
-  std::size_t segments = 0;
-  for (const auto& t : T) {
-    const bool s[3] = {above(t[0]), above(t[1]), above(t[2])};
-    if (s[0] == s[1] && s[1] == s[2]) continue;
-    // The vertex alone on its side, and its neighbours in the triangle's order.
-    const int lone = s[0] != s[1] && s[0] != s[2] ? 0 : (s[1] != s[0] && s[1] != s[2] ? 1 : 2);
-    const int L = t[lone], N = t[(lone + 1) % 3], Pv = t[(lone + 2) % 3];
-    const int c_next = crossing(L, N), c_prev = crossing(Pv, L);
-    // Direction ez x n (outside on the right): from the edge leaving an upper lone vertex to the
-    // edge entering it; reversed for a lower one.
-    const int from = s[lone] ? c_next : c_prev, to = s[lone] ? c_prev : c_next;
-    if (next.size() < pts.size()) next.resize(pts.size(), -1);
-    if (next[from] >= 0) throw MeshError("The section of the mesh by the plane z = 0 is not a set of closed curves.");
-    next[from] = to;
-    ++segments;
-  }
-  if (segments == 0) throw MeshError("The plane z = 0 does not cut the mesh: its section there is empty.");
-  next.resize(pts.size(), -1);
-  std::vector<std::vector<Point>> loops;
-  std::vector<char> used(pts.size(), 0);
-  for (std::size_t s0 = 0; s0 < pts.size(); ++s0) {
-    if (used[s0] || next[s0] < 0) continue;
-    std::vector<Point> loop;
-    int p = int(s0);
-    while (!used[p]) {
-      used[p] = 1;
-      // Coincident consecutive points (the plane through a vertex) are kept once.
-      if (loop.empty() || pts[p] != loop.back()) loop.push_back(pts[p]);
-      p = next[p];
-      if (p < 0) throw MeshError("The section of the mesh by the plane z = 0 is not a set of closed curves.");
-    }
-    if (p != int(s0)) throw MeshError("The section of the mesh by the plane z = 0 is not a set of closed curves.");
-    while (loop.size() > 1 && loop.back() == loop.front()) loop.pop_back();
-    if (loop.size() >= 3) loops.push_back(std::move(loop));
-  }
-  if (loops.empty()) throw MeshError("The plane z = 0 does not cut the mesh: its section there has no area.");
-  return loops;
-}
-
 SampledBody sample_section(const std::vector<std::vector<Point>>& loops, double dx, int layers) {
   struct Segment {
     Point a, b, normal;
@@ -772,10 +471,8 @@ SampledBody sample_section(const std::vector<std::vector<Point>>& loops, double 
     cr.clear();
     for (std::size_t q = rows.start[j]; q < rows.start[j + 1]; ++q) {
       const auto& s = segs[rows.items[q]];
-      const bool ua = s.a[1] >= y0, ub = s.b[1] >= y0;
-      if (ua == ub) continue;
-      const double x = s.a[0] + (y0 - s.a[1]) * (s.b[0] - s.a[0]) / (s.b[1] - s.a[1]);
-      cr.push_back({x, ub ? -1 : 1});  // upward on a counter-clockwise boundary: leaving along +x
+      Crossing c;
+      if (segment_crossing(s.a, s.b, y0, c)) cr.push_back(c);
     }
     std::sort(cr.begin(), cr.end(), [](const Crossing& a, const Crossing& b) { return a.x < b.x; });
   };
@@ -796,7 +493,7 @@ SampledBody sample_section(const std::vector<std::vector<Point>>& loops, double 
     boxes[q] = {Point{std::min(s.a[0], s.b[0]), std::min(s.a[1], s.b[1]), 0.0},
                 Point{std::max(s.a[0], s.b[0]), std::max(s.a[1], s.b[1]), 0.0}};
   }
-  const Bvh bvh(boxes);
+  const Bvh bvh(std::move(boxes));
   int hint = -1;  // the previous query's segment bounds the next search (lattice order)
   auto depth_of = [&](const Point& x, double limit) -> SurfaceHit {
     double best_d2 = limit < kInf ? limit * limit : kInf;

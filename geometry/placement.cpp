@@ -31,6 +31,13 @@ Point PlacementMap::move(const Point& p) const {
   return {r[0] + t_[0], r[1] + t_[1], r[2] + t_[2]};
 }
 
+Point PlacementMap::rotate_back(const Point& v) const {
+  return {m_[0][0] * v[0] + m_[1][0] * v[1] + m_[2][0] * v[2], m_[0][1] * v[0] + m_[1][1] * v[1] + m_[2][1] * v[2],
+          m_[0][2] * v[0] + m_[1][2] * v[1] + m_[2][2] * v[2]};
+}
+
+Point PlacementMap::move_back(const Point& p) const { return rotate_back({p[0] - t_[0], p[1] - t_[1], p[2] - t_[2]}); }
+
 Point PlacementMap::apply(const Point& p) const { return move({scale_ * p[0], scale_ * p[1], scale_ * p[2]}); }
 
 }  // namespace turbid::geometry

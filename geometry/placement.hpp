@@ -26,6 +26,10 @@ class PlacementMap {
   Point move(const Point& p) const;
   // R (scale p) + t: a point in the shape's own, unscaled frame (mesh vertices).
   Point apply(const Point& p) const;
+  // R^T v: the inverse of rotate.
+  Point rotate_back(const Point& v) const;
+  // R^T (p - t): the inverse of move (a placed point back in the shape's scaled frame).
+  Point move_back(const Point& p) const;
 
  private:
   double m_[3][3];  // row-major R

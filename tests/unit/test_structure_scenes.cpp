@@ -19,9 +19,8 @@
 //    0.2 x 0.1 m section within 1 %;
 //  - fluid left out: a pipe inside a block of fluid; point by point against the analytic cylinder,
 //    every lattice point inside it or within dx/2 of it is left out and no fluid particle is closer
-//    than dx/2; the count lies above V / dx^3. That nothing farther is left out (count ~ W / dx^3, W
-//    the volume of the cylinder grown by dx/2) is a disabled test: the engine leaves out fluid up to
-//    1.5 dx beyond the caps' rims (see the test);
+//    than dx/2; the count lies above V / dx^3; and nothing farther is left out (count = the lattice
+//    points within dx/2 of the analytic cylinder, W / dx^3 with W the cylinder grown by dx/2);
 //  - errors through the scene path: a missing mesh is a SceneError at FILE:LINE:COL of the file name;
 //    an open, inside-out or empty mesh makes fsi::Simulation throw std::invalid_argument naming the
 //    scene file and line, the structure, the mesh file and the defect.
@@ -430,7 +429,7 @@ TEST(StructureScenes, FluidLatticePointsInsideTheMeshAreLeftOut) {
   // The count against the volume. V / dx^3 = 3142 lattice points lie in the solid (here: `inside`);
   // the carver also takes those within dx/2 outside: the cylinder grown by dx/2, of volume
   // W = pi (R + dx/2)^2 (L + dx) = 1.24 V (its rims rounded: 0.1 % less), so removed ~ W / dx^3.
-  // Lower bound: V / dx^3 and the points inside; the upper side is the disabled test below.
+  // Lower bound: V / dx^3 and the points inside; the upper side is the next test.
   const double V = kPi * kR * kR * kLPipe;
   const double W = kPi * (kR + 0.5 * dx) * (kR + 0.5 * dx) * (kLPipe + dx);
   const double removed = double(w.summary.fluid_removed_by_structures);
@@ -442,16 +441,11 @@ TEST(StructureScenes, FluidLatticePointsInsideTheMeshAreLeftOut) {
   EXPECT_GE(removed, double(near) * (1 - 1e-3));  // a few points within the sagitta of dx/2 may stay
 }
 
-// Known engine defect (fsi/simulation.cpp, StructureCarver::blocks): beyond a convex edge (here the
-// rims of the pipe's caps) the nearest structure particle can be one whose normal is the other
-// face's (a side particle of the last slab), and the signed distance to that face's tangent plane
-// leaves out fluid that is up to 1.5 dx from the body (the limit is the carver's bounding box,
-// particles +- 2 dx, not the rule). Measured: 4005 removed against 3933 lattice points within dx/2,
-// 72 of them 0.6 to 1.46 dx beyond the caps. Not particular to meshes: a primitive box 0.2 x 0.1 x
-// 0.05 m placed the same way loses 175 lattice points farther than dx/2 (up to 1.38 dx), the same
-// box as block.ply 206 (up to 1.95 dx). Enable when the carver is fixed
-// (--gtest_also_run_disabled_tests runs it now).
-TEST(StructureScenes, DISABLED_NoFluidFartherThanHalfASpacingIsLeftOut) {
+// Nothing farther than dx/2 is left out: the carver uses each structure's exact signed distance
+// (geometry/solid.hpp). Reference: the lattice points within dx/2 of the analytic cylinder, 3933;
+// the earlier nearest-particle tangent-plane rule left out 4005 (72 up to 1.46 dx beyond the rims of
+// the caps).
+TEST(StructureScenes, NoFluidFartherThanHalfASpacingIsLeftOut) {
   const ImmersedPipe w;
   const double dx = w.dx, cell = dx * dx * dx;
   std::size_t near = 0, far_removed = 0;
