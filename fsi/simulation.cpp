@@ -219,6 +219,9 @@ sph::PhysicsParams physics_params(const Scene& scene) {
     p.materials[m].dynamic_viscosity = sph::Real(ms.viscosity);
   }
   p.wall_material = 0;
+  p.uniform_sound_speed = true;
+  for (int m = 1; m < p.material_count; ++m)
+    p.uniform_sound_speed = p.uniform_sound_speed && p.materials[m].sound_speed == p.materials[0].sound_speed;
   p.boundary = scene.numerics.boundary == BoundaryKind::mdbc ? sph::Boundary::mdbc : sph::Boundary::dbc;
   p.mdbc_no_slip = scene.numerics.no_slip;
   p.body_count = int(scene.structures.size());

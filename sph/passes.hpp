@@ -519,6 +519,9 @@ struct MomentumPass {
     const std::uint32_t padded = (m + W - 1) / W * W;
     alignas(32) Real rho_j[kMaxNeighbours + W], p_j[kMaxNeighbours + W], m_j[kMaxNeighbours + W],
         c_j[kMaxNeighbours + W];
+    const Real c_i = Mi.sound_speed;
+    // One sound speed for every material (and the walls'): no per-neighbour material lookups.
+    const bool one_c = prm.uniform_sound_speed;
     for (std::uint32_t k = 0; k < padded; ++k) {
       const bool valid = k < m;
       const std::uint32_t j = valid ? nb[k] : i;
@@ -527,13 +530,13 @@ struct MomentumPass {
       rho_j[k] = P.density[j];
       p_j[k] = P.pressure[j];
       m_j[k] = valid ? P.mass[j] : Real(0);
-      const int material_j = P.material[j];
-      c_j[k] = prm.materials[P.kind[j] == std::uint8_t(Kind::fluid) ? material_j : prm.wall_material].sound_speed;
+      c_j[k] = one_c ? c_i
+                     : prm.materials[P.kind[j] == std::uint8_t(Kind::fluid) ? int(P.material[j]) : prm.wall_material]
+                           .sound_speed;
     }
     const Real inv_h = Real(1) / h;
     const Real eta2 = kEta2Factor * h * h;
     const Real ah = prm.artificial_viscosity * h;
-    const Real c_i = Mi.sound_speed;
     Real sum[D][W] = {};
     for (std::uint32_t k0 = 0; k0 < padded; k0 += W) {
       for (int l = 0; l < W; ++l) {

@@ -69,6 +69,7 @@ struct PhysicsParams {
   Real gravity[3] = {0, 0, 0}; // [m/s^2]
   int material_count = 0;
   int wall_material = 0;       // EOS used for wall particles' pressure
+  bool uniform_sound_speed = false;  // every material has the same c0 (pair loops skip the lookup)
   MaterialParams materials[kMaxMaterials];
 };
 
