@@ -80,6 +80,9 @@ class Simulation {
   std::uint64_t removed() const { return solver_->removed(); }
   std::uint64_t inflow() const { return solver_->inflow(); }    // particles created at inlets
   std::uint64_t outflow() const { return solver_->outflow(); }  // particles gone through outlets
+  void restore_open_boundary_counts(std::uint64_t inflow, std::uint64_t outflow) {
+    solver_->restore_open_boundary_counts(inflow, outflow);
+  }
   double last_time_step() const { return solver_->last_time_step(); }
   double wall_seconds() const { return wall_seconds_; }
   double particle_steps_per_second() const;

@@ -56,6 +56,11 @@ class Solver {
   std::uint64_t removed() const { return removed_; }
   std::uint64_t inflow() const { return inflow_; }    // particles created at inlets
   std::uint64_t outflow() const { return outflow_; }  // particles gone through outlets
+  // A resumed run continues the open-boundary counts of the run that wrote the checkpoint.
+  void restore_open_boundary_counts(std::uint64_t inflow, std::uint64_t outflow) {
+    inflow_ = inflow;
+    outflow_ = outflow;
+  }
   double last_time_step() const { return last_dt_; }
   Backend& backend() { return *backend_; }
   const PhysicsParams& params() const { return params_; }

@@ -102,6 +102,8 @@ class Writers final : public fsi::Observer {
     state["output_index"] = sim.output_index();
     state["checkpoint_index"] = sim.checkpoint_index();
     state["particle_steps"] = sim.particle_steps();
+    state["inflow"] = sim.inflow();
+    state["outflow"] = sim.outflow();
     state["wall_seconds"] = sim.wall_seconds();
     state["particle_spacing"] = sim.scene().particle_spacing;
     state["end_time"] = sim.scene().end_time;
@@ -272,6 +274,7 @@ nlohmann::json run_scene(const RunRequest& request) {
       sim.resume(state.at("time").get<double>(), state.at("steps").get<std::uint64_t>(),
                  state.at("removed").get<std::uint64_t>(), state.at("output_index").get<std::uint64_t>(),
                  state.at("checkpoint_index").get<std::uint64_t>(), state.at("particle_steps").get<std::uint64_t>());
+      sim.restore_open_boundary_counts(state.value("inflow", std::uint64_t(0)), state.value("outflow", std::uint64_t(0)));
     } else {
       sim.start();
     }
