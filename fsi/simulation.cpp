@@ -5,9 +5,11 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <unordered_map>
 #include <utility>
 
 #include "fsi/probes.hpp"
@@ -172,10 +174,80 @@ class StructureCarver {
     return false;
   }
 
+  // The smallest signed distance of p to the structures, exact where it is below `cutoff`.
+  double distance(const Point& p, double cutoff) const {
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& s : solids_) best = std::min(best, s.signed_distance(p, cutoff));
+    return best;
+  }
+
+  bool empty() const { return solids_.empty(); }
+
  private:
   std::vector<geometry::Solid> solids_;
   double dx_;
 };
+
+// Lattice carving leaves out whole cells: a lattice point within dx/2 of a structure takes its cell
+// with it, also the part of the cell outside the structure, so the fluid would be short of that
+// volume (a hole up to dx/2 wider than the body all round: +21% for a 0.15 m cube at dx = 0.02 m
+// whose faces fall mid-cell, and that much more buoyancy). Each carved cell is therefore sampled at
+// 8^d stratified points; every sample outside all structures hands its share of the cell's volume to the
+// nearest kept lattice point of the same fluid block among the carved cell's 3^d neighbours, whose
+// particle then stands for its cell plus that part of the gap (mass = rho V); `moments` gets the
+// first moment sum V_s y_s of the samples each point receives (the caller moves the particle to the
+// centroid of its cell and samples). Returns the volume handed over [m^d]; samples with no kept
+// neighbour (a sliver between two structures) are dropped.
+double restore_carved_volume(const StructureCarver& carver, const geometry::Aabb& box, double dx, int d,
+                             const std::vector<Point>& carved, const std::vector<Point>& kept,
+                             const std::vector<double*>& volumes, std::vector<Point>& moments) {
+  // Samples per cell edge, a multiple of 4: no sample lies on a face at a quarter or half cell.
+  constexpr int kSub = 8;
+  auto index_of = [&](const Point& x, int k) { return long(std::floor((x[k] - box.min[k]) / dx)); };
+  long n[3] = {1, 1, 1};
+  for (int k = 0; k < d; ++k) n[k] = std::max(1L, long(std::llround((box.max[k] - box.min[k]) / dx)) + 1);
+  auto key = [&](long i, long j, long k) { return (k * n[1] + j) * n[0] + i; };
+  std::unordered_map<long, std::size_t> at;
+  at.reserve(kept.size());
+  for (std::size_t q = 0; q < kept.size(); ++q)
+    at.emplace(key(index_of(kept[q], 0), index_of(kept[q], 1), d == 3 ? index_of(kept[q], 2) : 0), q);
+  const double sub_volume = std::pow(dx / kSub, d);
+  const double reach = 0.5 * std::sqrt(double(d)) * dx;  // a cell's corner from its centre
+  double restored = 0;
+  for (const auto& c : carved) {
+    if (carver.distance(c, 2 * dx) < -reach) continue;  // the whole cell lies inside a structure
+    const long ci = index_of(c, 0), cj = index_of(c, 1), ck = d == 3 ? index_of(c, 2) : 0;
+    const int sz = d == 3 ? kSub : 1;
+    for (int a = 0; a < kSub; ++a)
+      for (int b = 0; b < kSub; ++b)
+        for (int e = 0; e < sz; ++e) {
+          Point y = c;
+          y[0] += ((a + 0.5) / kSub - 0.5) * dx;
+          y[1] += ((b + 0.5) / kSub - 0.5) * dx;
+          if (d == 3) y[2] += ((e + 0.5) / kSub - 0.5) * dx;
+          if (carver.distance(y, dx) <= 0) continue;
+          double best = std::numeric_limits<double>::infinity();
+          std::size_t owner = kept.size();
+          for (long dk = (d == 3 ? -1 : 0); dk <= (d == 3 ? 1 : 0); ++dk)
+            for (long dj = -1; dj <= 1; ++dj)
+              for (long di = -1; di <= 1; ++di) {
+                const auto it = at.find(key(ci + di, cj + dj, ck + dk));
+                if (it == at.end()) continue;
+                double r2 = 0;
+                for (int k = 0; k < d; ++k) r2 += (kept[it->second][k] - y[k]) * (kept[it->second][k] - y[k]);
+                if (r2 < best) {
+                  best = r2;
+                  owner = it->second;
+                }
+              }
+          if (owner == kept.size()) continue;
+          *volumes[owner] += sub_volume;
+          for (int k = 0; k < d; ++k) moments[owner][k] += sub_volume * y[k];
+          restored += sub_volume;
+        }
+  }
+  return restored;
+}
 
 }  // namespace
 
@@ -357,15 +429,36 @@ void Simulation::build_particles() {
          << 10 * std::sqrt(2 * g * column) << " m/s, ten times the free-fall speed)";
       throw std::invalid_argument(os.str());
     }
+    const std::size_t first = items.size();
+    std::vector<Point> carved;
     for (const auto& x : geometry::fill_box(to_aabb(f.box), dx, d)) {
       if (carver.blocks(x)) {
         ++summary_.fluid_removed_by_structures;
+        carved.push_back(x);
         continue;
       }
       const double depth = std::max(0.0, top - height_of(s, x));
       items.push_back({x, eos.hydrostatic_density(g, depth), m, sph::Kind::fluid, {0, 0, 0}, sph::kNoBody, cell_volume,
                        profile_velocity(f.initial_velocity, f.box, x, d)});
       ++summary_.particles_per_material[m];
+    }
+    // The fluid's share of the carved cells goes to the nearest kept particles (see below).
+    if (!carved.empty()) {
+      std::vector<double*> volumes;
+      for (std::size_t i = first; i < items.size(); ++i) volumes.push_back(&items[i].volume);
+      std::vector<Point> kept;
+      for (std::size_t i = first; i < items.size(); ++i) kept.push_back(items[i].x);
+      std::vector<Point> moments(kept.size(), Point{0, 0, 0});
+      summary_.fluid_volume_restored +=
+          restore_carved_volume(carver, to_aabb(f.box), dx, d, carved, kept, volumes, moments);
+      // A particle that took over part of the gap moves to the centroid of all it stands for, and
+      // starts at the hydrostatic density there.
+      for (std::size_t q = 0; q < kept.size(); ++q) {
+        Item& it = items[first + q];
+        if (it.volume <= cell_volume) continue;
+        for (int k = 0; k < d; ++k) it.x[k] = (kept[q][k] * cell_volume + moments[q][k]) / it.volume;
+        it.density = eos.hydrostatic_density(g, std::max(0.0, top - height_of(s, it.x)));
+      }
     }
   }
   summary_.fluid_particles = items.size();

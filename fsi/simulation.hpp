@@ -34,6 +34,7 @@ struct WorldSummary {
   std::size_t structure_particles = 0;
   std::size_t buffer_particles = 0;  // open-boundary zones
   std::size_t fluid_removed_by_structures = 0;  // fluid lattice points inside or touching a structure
+  double fluid_volume_restored = 0;  // the part of their cells outside the structures, given to neighbours [m^d]
   std::vector<StructureSummary> structures;
   std::vector<std::size_t> particles_per_material;
   double smoothing_length = 0;     // [m]

@@ -182,7 +182,9 @@ std::string describe_scene(const fsi::Scene& scene) {
        << (ob.inlet ? std::to_string(ob.velocity.mean) + " m/s" : std::string(", pressure = background pressure"))
        << "\n";
   if (s.fluid_removed_by_structures > 0)
-    os << "  fluid lattice points left out inside structures: " << s.fluid_removed_by_structures << "\n";
+    os << "  fluid lattice points left out inside structures: " << s.fluid_removed_by_structures
+       << " (the part of their cells outside the structures, " << s.fluid_volume_restored << (two_d ? " m^2" : " m^3")
+       << ", goes to the nearest fluid particles)\n";
   for (std::size_t m = 0; m < scene.materials.size(); ++m)
     os << "  material " << scene.materials[m].name << ": " << s.particles_per_material[m]
        << " particles, sound speed " << s.sound_speed[m] << " m/s\n";

@@ -11,6 +11,9 @@ step when a definition changes.
                        sqrt(g H).
   cylinder_2d_re20     relative error of C_D (forces.csv, mean over t >= 2.5 s) against
                        Schaefer & Turek's 5.5795; also the mean C_L.
+  cylinder_2d_re100    Schaefer & Turek 2D-2: largest relative error of C_D,max, C_L,max and the
+                       Strouhal number (from the mean period between upward zero crossings of
+                       C_L - mean C_L) over the last 2 s, against 3.23, 1.00 and 0.30.
   buoyancy_2d          largest relative error of the mean vertical force (t >= 1 s) on the box
                        and the cylinder against rho0 g V.
 
@@ -196,6 +199,39 @@ def dfg_error(run_dir):
     return abs(forces_mean(run_dir, "cylinder.C_D [-]", DFG_FROM) - DFG_CD) / DFG_CD
 
 
+# Schaefer & Turek (1996) 2D-2 (same file): C_D,max 3.23, C_L,max 1.00, St = f D / U_mean 0.30.
+DFG2_REFERENCE = {"C_D_max": 3.23, "C_L_max": 1.00, "St": 0.30}
+DFG2_WINDOW = 2.0  # s: the last two seconds of the run (about six shedding periods)
+DFG2_D, DFG2_U = 0.1, 1.0  # m, m/s
+
+
+def dfg2_values(run_dir):
+    """{'C_D_max', 'C_L_max', 'St', 'periods'} over the last DFG2_WINDOW seconds of forces.csv."""
+    f = read_csv(os.path.join(run_dir, "forces.csv"))
+    t_all = f["time [s]"]
+    t_from = t_all[-1] - DFG2_WINDOW
+    rows = [(t, cd, cl) for t, cd, cl in zip(t_all, f["cylinder.C_D [-]"], f["cylinder.C_L [-]"]) if t >= t_from]
+    if len(rows) < 10:
+        raise ValueError(f"{run_dir}: too few forces.csv rows in the last {DFG2_WINDOW} s")
+    t = [r[0] for r in rows]
+    cl_mean = sum(r[2] for r in rows) / len(rows)
+    up = []  # times of upward zero crossings of C_L - mean, linearly interpolated
+    for k in range(1, len(rows)):
+        a, b = rows[k - 1][2] - cl_mean, rows[k][2] - cl_mean
+        if a < 0 <= b:
+            up.append(t[k - 1] + (t[k] - t[k - 1]) * (-a) / (b - a))
+    if len(up) < 3:
+        raise ValueError(f"{run_dir}: C_L has fewer than two periods in the last {DFG2_WINDOW} s (no shedding yet?)")
+    period = (up[-1] - up[0]) / (len(up) - 1)
+    return {"C_D_max": max(r[1] for r in rows), "C_L_max": max(r[2] for r in rows),
+            "St": DFG2_D / (period * DFG2_U), "periods": len(up) - 1}
+
+
+def dfg2_error(run_dir):
+    v = dfg2_values(run_dir)
+    return max(abs(v[k] - ref) / ref for k, ref in DFG2_REFERENCE.items())
+
+
 def buoyancy_error(run_dir):
     volumes = {"box": 0.2 * 0.2, "cylinder": math.pi * 0.1 * 0.1}
     worst = 0.0
@@ -211,6 +247,11 @@ METRICS = {
         "error": dfg_error,
         "extra": {"C_D": lambda d: forces_mean(d, "cylinder.C_D [-]", DFG_FROM),
                   "C_L": lambda d: forces_mean(d, "cylinder.C_L [-]", DFG_FROM)},
+    },
+    "cylinder_2d_re100": {
+        "description": "largest relative error of C_D,max, C_L,max, St vs Schaefer & Turek 2D-2 (last 2 s)",
+        "error": dfg2_error,
+        "extra": {k: (lambda d, k=k: dfg2_values(d)[k]) for k in ("C_D_max", "C_L_max", "St", "periods")},
     },
     "buoyancy_2d": {
         "description": "largest relative error of the mean F_y (t >= 1 s) vs rho0 g V (box, cylinder)",

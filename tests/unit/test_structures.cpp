@@ -197,8 +197,10 @@ TEST(Structures, FluidInsideStructuresIsLeftOutAndSummariesGiveAreaAndVolume) {
   EXPECT_NEAR(sum.structures[0].surface_area, 2 * kPi * 0.06, 0.01 * 2 * kPi * 0.06);
   EXPECT_NEAR(sum.structures[1].volume, 0.08 * 0.12, 0.01 * 0.08 * 0.12);
   EXPECT_NEAR(sum.structures[1].surface_area, 0.4, 0.01 * 0.4);
-  // No fluid particle lies inside a structure or within dx/2 of its surface: for the circle,
-  // |x - c| >= r + dx/2 (up to float rounding of positions).
+  // No fluid particle lies inside a structure: lattice points within dx/2 of the surface are left out,
+  // and a particle next to the surface moves towards it only to the centroid of its cell and the part
+  // of the gap it took over (simulation.cpp, restore_carved_volume), which for a circle of r = 6 dx
+  // keeps it at least dx/4 from the surface: |x - c| >= r + dx/4.
   const auto& st = sim.store();
   const auto& id = sim.fields();
   const auto* x = st.data<sph::Vec<2>>(id.position);
@@ -208,7 +210,7 @@ TEST(Structures, FluidInsideStructuresIsLeftOutAndSummariesGiveAreaAndVolume) {
     if (kind[i] != 0) continue;
     closest = std::min(closest, std::hypot(double(x[i][0]) - 0.13, double(x[i][1]) - 0.2));
   }
-  EXPECT_GE(closest, 0.06 + 0.5 * scene.particle_spacing - 1e-6);
+  EXPECT_GE(closest, 0.06 + 0.25 * scene.particle_spacing);
   EXPECT_LT(closest, 0.06 + 1.5 * scene.particle_spacing) << "and no wider gap than one spacing";
   // Lattice points left out: about (circle area + box area) / dx^2 plus the dx/2 margin.
   const double inside = (kPi * 0.06 * 0.06 + 0.08 * 0.12) / (0.01 * 0.01);
