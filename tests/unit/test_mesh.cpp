@@ -25,94 +25,26 @@
 #include <fstream>
 #include <numbers>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 #include "geometry/mesh.hpp"
 #include "geometry/primitives.hpp"
+#include "mesh_test_support.hpp"
 
 namespace {
 
 using turbid::geometry::load_mesh;
 using turbid::geometry::MeshError;
 using turbid::geometry::Placement;
-using turbid::geometry::Point;
-using turbid::geometry::SampledBody;
 using turbid::geometry::sample_mesh;
-using turbid::geometry::TriangleMesh;
 namespace fs = std::filesystem;
+using namespace turbid::test;
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kR = 0.05;  // sphere and cylinder radius [m]
 constexpr double kL = 0.2;   // cylinder length [m]
 
-double rel(double estimate, double reference) { return std::abs(estimate - reference) / std::abs(reference); }
-double dot(const Point& a, const Point& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-double norm(const Point& a) { return std::sqrt(dot(a, a)); }
-Point sub(const Point& a, const Point& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Point cross(const Point& a, const Point& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-Point on_surface(const SampledBody& b, std::size_t i) {
-  return {b.points[i][0] + b.depth[i] * b.normals[i][0], b.points[i][1] + b.depth[i] * b.normals[i][1],
-          b.points[i][2] + b.depth[i] * b.normals[i][2]};
-}
-
 // ---- meshes in code ---------------------------------------------------------------------------
-
-// UV sphere, outward faces; the equator ring lies exactly on z = 0 (nlat even).
-TriangleMesh uv_sphere(double R, int nlat, int nlon) {
-  TriangleMesh m;
-  m.vertices.push_back({0, 0, R});
-  for (int i = 1; i < nlat; ++i) {
-    const double th = kPi * i / nlat;
-    const double z = 2 * i == nlat ? 0.0 : R * std::cos(th), rho = 2 * i == nlat ? R : R * std::sin(th);
-    for (int j = 0; j < nlon; ++j) {
-      const double ph = 2 * kPi * j / nlon;
-      m.vertices.push_back({rho * std::cos(ph), rho * std::sin(ph), z});
-    }
-  }
-  m.vertices.push_back({0, 0, -R});
-  const int south = int(m.vertices.size()) - 1;
-  auto ring = [&](int i, int j) { return 1 + (i - 1) * nlon + (j % nlon); };
-  for (int j = 0; j < nlon; ++j) m.triangles.push_back({0, ring(1, j), ring(1, j + 1)});
-  for (int i = 1; i + 1 < nlat; ++i)
-    for (int j = 0; j < nlon; ++j) {
-      m.triangles.push_back({ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)});
-      m.triangles.push_back({ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)});
-    }
-  for (int j = 0; j < nlon; ++j) m.triangles.push_back({south, ring(nlat - 1, j + 1), ring(nlat - 1, j)});
-  return m;
-}
-
-// Prism over a counter-clockwise polygon (z in [z0, z1]); caps as a fan from vertex `fan`.
-TriangleMesh prism(const std::vector<std::array<double, 2>>& poly, double z0, double z1, int fan = 0) {
-  TriangleMesh m;
-  const int n = int(poly.size());
-  for (const auto& p : poly) m.vertices.push_back({p[0], p[1], z0});
-  for (const auto& p : poly) m.vertices.push_back({p[0], p[1], z1});
-  for (int i = 0; i < n; ++i) {
-    const int a = i, b = (i + 1) % n;
-    m.triangles.push_back({a, b, n + b});
-    m.triangles.push_back({a, n + b, n + a});
-  }
-  for (int k = 1; k + 1 < n; ++k) {
-    const int a = fan, b = (fan + k) % n, c = (fan + k + 1) % n;
-    m.triangles.push_back({n + a, n + b, n + c});  // top, normal +z
-    m.triangles.push_back({a, c, b});              // bottom, normal -z
-  }
-  return m;
-}
-
-TriangleMesh cylinder(double R, double L, int sides) {
-  std::vector<std::array<double, 2>> poly;
-  for (int j = 0; j < sides; ++j) poly.push_back({R * std::cos(2 * kPi * j / sides), R * std::sin(2 * kPi * j / sides)});
-  return prism(poly, -0.5 * L, 0.5 * L);
-}
-
-TriangleMesh box(double a, double b, double c) {
-  return prism({{-a / 2, -b / 2}, {a / 2, -b / 2}, {a / 2, b / 2}, {-a / 2, b / 2}}, -c / 2, c / 2);
-}
 
 TriangleMesh flipped(TriangleMesh m) {
   for (auto& t : m.triangles) std::swap(t[1], t[2]);
@@ -121,20 +53,9 @@ TriangleMesh flipped(TriangleMesh m) {
 
 // ---- writers ----------------------------------------------------------------------------------
 
-// A directory of this process under the system's temporary directory, removed at exit.
-struct ScratchDir {
-  fs::path path;
-  ScratchDir() : path(fs::temp_directory_path() / ("turbid-test-mesh-" + std::to_string(::getpid()))) {
-    fs::create_directories(path);
-  }
-  ~ScratchDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-};
-
+// This file's scratch directory, removed at exit.
 const fs::path& scratch() {
-  static const ScratchDir dir;
+  static const ScratchDir dir("mesh");
   return dir.path;
 }
 
@@ -261,7 +182,7 @@ TEST(MeshLoad, FormatsReproduceTheMeshWritten) {
     EXPECT_LT(rel(m.area(), sphere.area()), 1e-6) << p;
     EXPECT_LT(rel(m.volume(), sphere.volume()), 1e-6) << p;
   }
-  const TriangleMesh cyl = cylinder(kR, kL, 128);
+  const TriangleMesh cyl = cylinder_mesh(kR, kL, 128);
   EXPECT_LT(rel(cyl.area(), 2 * kPi * kR * kL + 2 * kPi * kR * kR), 0.002);
   EXPECT_LT(rel(cyl.volume(), kPi * kR * kR * kL), 0.002);
   const TriangleMesh c = load_mesh(write_obj("cylinder.obj", cyl));
@@ -275,7 +196,7 @@ TEST(MeshLoad, FormatsReproduceTheMeshWritten) {
   EXPECT_LT(rel(b.area(), 2 * (0.2 * 0.1 + 0.1 * 0.06 + 0.06 * 0.2)), 1e-6);
   // Two objects in one OBJ file (two assimp meshes): merged into one mesh of both volumes.
   {
-    const TriangleMesh unit = box(1, 1, 1);
+    const TriangleMesh unit = box_mesh(1, 1, 1);
     std::ofstream f(path_of("two_objects.obj"));
     for (int o = 0; o < 2; ++o) {
       f << "o part" << o << "\n";
@@ -316,7 +237,7 @@ TEST(MeshSample3D, SphereAreaVolumeNormalsDepth) {
       const double r = norm(x);
       const double c = dot(b.normals[i], x) / r;
       worst_angle = std::max(worst_angle, std::acos(std::min(1.0, c)) * 180 / kPi);
-      const double rs = norm(on_surface(b, i));
+      const double rs = norm(surface_point(b, i));
       EXPECT_GT(rs, r_min - 0.05 * dx);
       EXPECT_LT(rs, kR + 0.05 * dx);
     }
@@ -325,7 +246,7 @@ TEST(MeshSample3D, SphereAreaVolumeNormalsDepth) {
 }
 
 TEST(MeshSample3D, CylinderAreaVolume) {
-  const TriangleMesh mesh = load_mesh(write_obj("cylinder3d.obj", cylinder(kR, kL, 128)));
+  const TriangleMesh mesh = load_mesh(write_obj("cylinder3d.obj", cylinder_mesh(kR, kL, 128)));
   for (const double dx : {0.01, 0.005}) {
     const SampledBody b = sample_mesh(mesh, dx, 0, 3);
     expect_consistent(b, dx, 0);
@@ -343,7 +264,7 @@ TEST(MeshSample3D, CylinderAreaVolume) {
       // (1e-9: rounding of the side normals' axial component, the vertices are floats)
       EXPECT_GE(b.normals[i][0] * x[0] + b.normals[i][1] * x[1], -1e-9 * norm(x));
       EXPECT_GE(b.normals[i][2] * x[2], -1e-9 * norm(x));
-      const Point s = on_surface(b, i);  // on the side or on a cap
+      const Point s = surface_point(b, i);  // on the side or on a cap
       const double side = std::abs(std::hypot(s[0], s[1]) - kR), cap = std::abs(std::abs(s[2]) - 0.5 * kL);
       EXPECT_LT(std::min(side, cap), 0.05 * dx);
     }
@@ -354,7 +275,7 @@ TEST(MeshSample2D, SectionsAreCircles) {
   // The sphere's equator is a ring of vertices on z = 0 (a cut through vertices); the cylinder is cut
   // through the middle of its side triangles.
   const TriangleMesh sphere = load_mesh(write_ascii_stl("sphere2d.stl", uv_sphere(kR, 48, 96)));
-  const TriangleMesh cyl = load_mesh(write_obj("cylinder2d.obj", cylinder(kR, kL, 128)));
+  const TriangleMesh cyl = load_mesh(write_obj("cylinder2d.obj", cylinder_mesh(kR, kL, 128)));
   for (const TriangleMesh* mesh : {&sphere, &cyl})
     for (const double dx : {0.01, 0.005}) {
       const SampledBody b = sample_mesh(*mesh, dx, 0, 2);
@@ -369,7 +290,7 @@ TEST(MeshSample2D, SectionsAreCircles) {
         EXPECT_EQ(x[2], 0.0);
         EXPECT_EQ(b.normals[i][2], 0.0);
         EXPECT_GT(dot(b.normals[i], x) / norm(x), std::cos(10 * kPi / 180));  // radial, outward
-        EXPECT_NEAR(norm(on_surface(b, i)), kR, 0.001 * kR + 0.05 * dx);     // 96-gon sagitta 5e-4 R
+        EXPECT_NEAR(norm(surface_point(b, i)), kR, 0.001 * kR + 0.05 * dx);     // 96-gon sagitta 5e-4 R
       }
     }
 }
@@ -406,7 +327,7 @@ TEST(MeshSample3D, ConcavePrismExactVolumeAndDepth) {
       const double want = std::min(dist2d(x[0], x[1]), hz - std::abs(x[2]));
       EXPECT_NEAR(b.depth[i], want, 1e-9);
       EXPECT_NEAR(b.volumes[i], dx * dx * dx, 1e-9 * dx * dx * dx);
-      const Point s = sub(on_surface(b, i), where.translation);
+      const Point s = sub(surface_point(b, i), where.translation);
       EXPECT_NEAR(std::min(dist2d(s[0], s[1]), hz - std::abs(s[2])), 0.0, 1e-9);  // on the surface
     }
   }
@@ -547,12 +468,12 @@ TEST(MeshErrors, EveryDefectIsNamed) {
   TriangleMesh open = sphere;
   open.triangles.pop_back();
   // Two boxes sharing the edge x = y = 0.5, z in [-0.5, 0.5]: four triangles on that edge.
-  TriangleMesh two = box(1, 1, 1);
-  const TriangleMesh other = box(1, 1, 1);
+  TriangleMesh two = box_mesh(1, 1, 1);
+  const TriangleMesh other = box_mesh(1, 1, 1);
   const int base = int(two.vertices.size());
   for (const auto& v : other.vertices) two.vertices.push_back({v[0] + 1, v[1] + 1, v[2]});
   for (const auto& t : other.triangles) two.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
-  TriangleMesh misoriented = box(1, 1, 1);
+  TriangleMesh misoriented = box_mesh(1, 1, 1);
   std::swap(misoriented.triangles[3][1], misoriented.triangles[3][2]);
   {
     std::ofstream(path_of("empty.stl"));  // 0 bytes

@@ -16,22 +16,17 @@
 #include <vector>
 
 #include "geometry/primitives.hpp"
+#include "mesh_test_support.hpp"
 
 namespace {
 
 using turbid::geometry::Placement;
-using turbid::geometry::Point;
-using turbid::geometry::SampledBody;
 using turbid::geometry::sample_box;
 using turbid::geometry::sample_cylinder;
 using turbid::geometry::sample_sphere;
+using namespace turbid::test;
 
 constexpr double kPi = std::numbers::pi;
-
-double rel(double estimate, double reference) { return std::abs(estimate - reference) / std::abs(reference); }
-
-double dot(const Point& a, const Point& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-double norm(const Point& a) { return std::sqrt(dot(a, a)); }
 
 // sum v (w_x x^2 + w_y y^2 + w_z z^2)
 double moment(const SampledBody& b, Point w) {
@@ -63,11 +58,6 @@ void expect_consistent(const SampledBody& b) {
   }
   EXPECT_NEAR(b.volume, v, 1e-12 * v);        // volume is the sum of the particle volumes
   EXPECT_NEAR(b.surface_area, s, 1e-12 * s);  // surface_area is the sum of the shares
-}
-
-Point surface_point(const SampledBody& b, std::size_t i) {
-  return {b.points[i][0] + b.depth[i] * b.normals[i][0], b.points[i][1] + b.depth[i] * b.normals[i][1],
-          b.points[i][2] + b.depth[i] * b.normals[i][2]};
 }
 
 // Depth of a particle at the given distances to the faces it may be nearest to: the minimum, or

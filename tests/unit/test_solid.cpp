@@ -34,24 +34,16 @@
 
 #include "geometry/mesh.hpp"
 #include "geometry/solid.hpp"
+#include "mesh_test_support.hpp"
 
 namespace {
 
 using turbid::geometry::MeshError;
 using turbid::geometry::Placement;
-using turbid::geometry::Point;
 using turbid::geometry::Solid;
-using turbid::geometry::TriangleMesh;
+using namespace turbid::test;
 
 constexpr double kPi = std::numbers::pi;
-
-Point sub(const Point& a, const Point& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-double dot(const Point& a, const Point& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-double norm(const Point& a) { return std::sqrt(dot(a, a)); }
-Point cross(const Point& a, const Point& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-Point axpy(const Point& a, double s, const Point& b) { return {a[0] + s * b[0], a[1] + s * b[1], a[2] + s * b[2]}; }
 
 // p' = Rz Ry Rx p + t (angles in degrees), written out here rather than taken from placement.cpp.
 struct Frame {
@@ -109,70 +101,8 @@ void expect_probes(const Solid& s, const Frame& f, const std::vector<Probe>& pro
   }
 }
 
-// ---- meshes in code -----------------------------------------------------------------------------
-
-// UV sphere, outward faces; the equator ring lies exactly on z = 0 (nlat even).
-TriangleMesh uv_sphere(double R, int nlat, int nlon) {
-  TriangleMesh m;
-  m.vertices.push_back({0, 0, R});
-  for (int i = 1; i < nlat; ++i) {
-    const double th = kPi * i / nlat;
-    const double z = 2 * i == nlat ? 0.0 : R * std::cos(th), rho = 2 * i == nlat ? R : R * std::sin(th);
-    for (int j = 0; j < nlon; ++j) {
-      const double ph = 2 * kPi * j / nlon;
-      m.vertices.push_back({rho * std::cos(ph), rho * std::sin(ph), z});
-    }
-  }
-  m.vertices.push_back({0, 0, -R});
-  const int south = int(m.vertices.size()) - 1;
-  auto ring = [&](int i, int j) { return 1 + (i - 1) * nlon + (j % nlon); };
-  for (int j = 0; j < nlon; ++j) m.triangles.push_back({0, ring(1, j), ring(1, j + 1)});
-  for (int i = 1; i + 1 < nlat; ++i)
-    for (int j = 0; j < nlon; ++j) {
-      m.triangles.push_back({ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)});
-      m.triangles.push_back({ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)});
-    }
-  for (int j = 0; j < nlon; ++j) m.triangles.push_back({south, ring(nlat - 1, j + 1), ring(nlat - 1, j)});
-  return m;
-}
-
-// Prism over a counter-clockwise polygon (z in [z0, z1]); caps as fans from vertex 0.
-TriangleMesh prism(const std::vector<std::array<double, 2>>& poly, double z0, double z1) {
-  TriangleMesh m;
-  const int n = int(poly.size());
-  for (const auto& p : poly) m.vertices.push_back({p[0], p[1], z0});
-  for (const auto& p : poly) m.vertices.push_back({p[0], p[1], z1});
-  for (int i = 0; i < n; ++i) {
-    const int a = i, b = (i + 1) % n;
-    m.triangles.push_back({a, b, n + b});
-    m.triangles.push_back({a, n + b, n + a});
-  }
-  for (int k = 1; k + 1 < n; ++k) {
-    m.triangles.push_back({n, n + k, n + k + 1});  // top, normal +z
-    m.triangles.push_back({0, k + 1, k});          // bottom, normal -z
-  }
-  return m;
-}
-
-TriangleMesh cylinder_mesh(double R, double L, int sides) {
-  std::vector<std::array<double, 2>> poly;
-  for (int j = 0; j < sides; ++j) poly.push_back({R * std::cos(2 * kPi * j / sides), R * std::sin(2 * kPi * j / sides)});
-  return prism(poly, -0.5 * L, 0.5 * L);
-}
-
-TriangleMesh box_mesh(double a, double b, double c) {
-  return prism({{-a / 2, -b / 2}, {a / 2, -b / 2}, {a / 2, b / 2}, {-a / 2, b / 2}}, -c / 2, c / 2);
-}
-
+// Analytic sphere (radius R, centre c): signed distance, negative inside.
 double sphere_distance(const Point& p, const Point& c, double R) { return norm(sub(p, c)) - R; }
-
-// Analytic cylinder (radius R, half length h, axis `axis` through c in the world frame).
-double cylinder_distance(const Point& p, const Point& c, const Point& axis, double R, double h) {
-  const Point d = sub(p, c);
-  const double along = dot(d, axis);
-  const double radial = norm(axpy(d, -along, axis)) - R, cap = std::abs(along) - h;
-  return std::min(std::max(radial, cap), 0.0) + std::hypot(std::max(radial, 0.0), std::max(cap, 0.0));
-}
 
 // ---- primitives ---------------------------------------------------------------------------------
 

@@ -39,7 +39,6 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 #include "fsi/forces.hpp"
@@ -48,11 +47,13 @@
 #include "sph/vec.hpp"
 #include "tools/runner.hpp"
 #include "tools/scene_reader.hpp"
+#include "mesh_test_support.hpp"
 
 namespace {
 
 using namespace turbid;
 namespace fs = std::filesystem;
+using namespace turbid::test;
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kR = 0.05;      // pipe and ball radius [m]
@@ -61,8 +62,6 @@ constexpr double kLPipe = 0.4;   // pipe length [m]
 const fs::path kSource = TURBID_SOURCE_DIR;
 const fs::path kMeshes = kSource / "scenes" / "meshes";
 
-double rel(double estimate, double reference) { return std::abs(estimate - reference) / std::abs(reference); }
-
 fsi::RunOptions cpu() {
   fsi::RunOptions r;
   r.backend = "cpu";
@@ -70,20 +69,9 @@ fsi::RunOptions cpu() {
   return r;
 }
 
-// A directory of this process under the system's temporary directory, removed at exit.
-struct ScratchDir {
-  fs::path path;
-  ScratchDir() : path(fs::temp_directory_path() / ("turbid-test-structure-scenes-" + std::to_string(::getpid()))) {
-    fs::create_directories(path);
-  }
-  ~ScratchDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-};
-
+// This file's scratch directory, removed at exit.
 const fs::path& scratch() {
-  static const ScratchDir dir;
+  static const ScratchDir dir("structure-scenes");
   return dir.path;
 }
 
@@ -137,23 +125,6 @@ const fsi::StructureSummary& structure(const fsi::WorldSummary& s, const std::st
   throw std::runtime_error("no structure " + name + " in the summary");
 }
 
-// Signed distance from p to the solid cylinder of radius r and length l whose axis is along `axis`
-// through c (negative inside).
-double cylinder_distance(const double p[3], const double c[3], int axis, double r, double l) {
-  double radial2 = 0, along = 0;
-  for (int k = 0; k < 3; ++k) {
-    const double d = p[k] - c[k];
-    if (k == axis) {
-      along = std::abs(d) - 0.5 * l;
-    } else {
-      radial2 += d * d;
-    }
-  }
-  const double radial = std::sqrt(radial2) - r;
-  const double out_r = std::max(radial, 0.0), out_a = std::max(along, 0.0);
-  return std::min(std::max(radial, along), 0.0) + std::hypot(out_r, out_a);
-}
-
 // ---- the scene file -----------------------------------------------------------------------------
 
 TEST(StructureScenes, PipeSceneSamplesTheStlWithinOnePercentAndCheckPrintsIt) {
@@ -183,7 +154,7 @@ TEST(StructureScenes, PipeSceneSamplesTheStlWithinOnePercentAndCheckPrintsIt) {
 
   // Placement: rotation [90, 0, 0] turns the axis along y, centre (0.45, 0.25, 0.075). Every structure
   // particle lies inside that cylinder; the outermost reach its side and caps (within one dx).
-  const double centre[3] = {0.45, 0.25, 0.075};
+  const geometry::Point centre{0.45, 0.25, 0.075};
   const auto& st = sim.store();
   const auto& id = sim.fields();
   const auto* x = st.data<sph::Vec<3>>(id.position);
@@ -191,8 +162,8 @@ TEST(StructureScenes, PipeSceneSamplesTheStlWithinOnePercentAndCheckPrintsIt) {
   double max_radial = 0, max_along = 0, worst = -1e300;
   for (std::size_t i = 0; i < st.size(); ++i) {
     if (kind[i] != std::uint8_t(sph::Kind::structure)) continue;
-    const double p[3] = {double(x[i][0]), double(x[i][1]), double(x[i][2])};
-    worst = std::max(worst, cylinder_distance(p, centre, 1, kR, kLPipe));
+    const geometry::Point p{double(x[i][0]), double(x[i][1]), double(x[i][2])};
+    worst = std::max(worst, cylinder_distance(p, centre, {0, 1, 0}, kR, 0.5 * kLPipe));
     max_radial = std::max(max_radial, std::hypot(p[0] - centre[0], p[2] - centre[2]));
     max_along = std::max(max_along, std::abs(p[1] - centre[1]));
   }
@@ -371,7 +342,7 @@ TEST(StructureScenes, MeshesIn2DAreCutByThePlaneOfTheSimulation) {
 struct ImmersedPipe {
   static constexpr double dx = 0.01;
   static constexpr int n[3] = {30, 50, 20};
-  static constexpr double centre[3] = {0.1537, 0.2512, 0.1063};
+  static constexpr geometry::Point centre{0.1537, 0.2512, 0.1063};
   fsi::WorldSummary summary;
   std::vector<double> distance;  // [dx], per lattice point, x fastest
   std::vector<char> kept;
@@ -394,8 +365,8 @@ struct ImmersedPipe {
     for (int k = 0; k < n[2]; ++k)
       for (int j = 0; j < n[1]; ++j)
         for (int i = 0; i < n[0]; ++i) {
-          const double p[3] = {(i + 0.5) * dx, (j + 0.5) * dx, (k + 0.5) * dx};
-          distance[index(i, j, k)] = cylinder_distance(p, centre, 1, kR, kLPipe) / dx;
+          const geometry::Point p{(i + 0.5) * dx, (j + 0.5) * dx, (k + 0.5) * dx};
+          distance[index(i, j, k)] = cylinder_distance(p, centre, {0, 1, 0}, kR, 0.5 * kLPipe) / dx;
         }
     const auto& st = sim.store();
     const auto& id = sim.fields();
@@ -405,9 +376,9 @@ struct ImmersedPipe {
       if (kind[i] != std::uint8_t(sph::Kind::fluid)) continue;
       const double v = double(st.data<sph::Real>(id.mass)[i]) / double(st.data<sph::Real>(id.density)[i]);
       fluid_volume += v;
-      const double p[3] = {double(x[i][0]), double(x[i][1]), double(x[i][2])};
+      const geometry::Point p{double(x[i][0]), double(x[i][1]), double(x[i][2])};
       for (int k = 0; k < 3; ++k) fluid_moment[k] += v * p[k];
-      closest_fluid = std::min(closest_fluid, cylinder_distance(p, centre, 1, kR, kLPipe));
+      closest_fluid = std::min(closest_fluid, cylinder_distance(p, centre, {0, 1, 0}, kR, 0.5 * kLPipe));
       kept[index(int(p[0] / dx), int(p[1] / dx), int(p[2] / dx))] = 1;  // at rest: still on the lattice
     }
   }
