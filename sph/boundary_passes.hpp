@@ -118,8 +118,8 @@ TURBID_HD inline Real ghost_interpolation(const ParticleView<D>& P, const GridVi
 // would otherwise carry the surface's pressure upwards and push the water away from the wall along
 // the contact line (a 3D tank at rest kept 0.05-0.2 m/s there; 0.03-0.1 m/s with the test).
 // The test needs no geometry: in a corner the walls fill most of the support and the fluid the rest.
-// Like our DBC walls, rho_b never falls below rest density: a wall that pulls fluid towards it
-// would let it through (and a free surface over a wall would stick to it).
+// Like our DBC walls, rho_b never falls below the density of zero absolute pressure (rest density
+// without background pressure; TaitEos::no_tension_density).
 // No-slip: the velocity the viscous terms see at the particle (field viscous_velocity) becomes
 // 2 v_wall - v~_g, v~_g the fluid velocity at the ghost node, so that it goes through v_wall at the
 // wall surface (English et al. 2022; Adami et al. 2012, C6); continuity keeps the wall's own
@@ -145,7 +145,8 @@ struct MdbcPass {
       const Real fluid = ghost_interpolation<D, K, UniformH>(P, G, prm, P.position[b] + n, n, h_b, rho, v_ghost, walls);
       if (fluid < prm.mdbc_wet_share * (Real(1) - walls)) rho = rho0;
     }
-    P.density[b] = rho > rho0 ? rho : rho0;
+    const Real rho_min = prm.materials[prm.wall_material].eos.no_tension_density();
+    P.density[b] = rho > rho_min ? rho : rho_min;
     if (no_slip) P.viscous_velocity[b] = Real(-1) * v_ghost;
   }
 };

@@ -27,6 +27,11 @@ struct TaitEos {
   TURBID_HD Real density(Real p) const {
     return rest_density * std::pow((p - background_pressure) / stiffness + Real(1), Real(1) / gamma);
   }
+  // Density at zero absolute pressure, the lowest a wall may take (walls carry no tension: a wall
+  // that pulled fluid towards it would let it through, and a free surface over a wall would stick).
+  // rho0 without background pressure; below rho0 with one, so that a wall under suction (behind a
+  // cylinder in a channel) follows the fluid down to p = 0.
+  TURBID_HD Real no_tension_density() const { return density(Real(0)); }
   // Density that balances the hydrostatic pressure rho0 g depth (depth >= 0 below the surface).
   double hydrostatic_density(double gravity, double depth) const {
     return double(rest_density) * std::pow(1.0 + double(rest_density) * gravity * depth / double(stiffness),

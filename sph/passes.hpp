@@ -162,7 +162,7 @@ template <int D>
 struct DriftPass {
   ParticleView<D> P;
   Real dt;
-  Real wall_rho0;
+  Real wall_rho_min;  // TaitEos::no_tension_density of the wall material
   TURBID_HD void operator()(std::uint32_t i) const {
     const Real rho = P.density[i] + dt * P.density_rate[i];
     if (P.kind[i] == std::uint8_t(Kind::fluid)) {
@@ -171,8 +171,8 @@ struct DriftPass {
     } else if (P.kind[i] == std::uint8_t(Kind::buffer)) {
       P.position[i] += dt * P.velocity[i];  // density and velocity: BufferPass
     } else {
-      // DBC walls never fall below rest density: a wall that sucks fluid in would let it through.
-      P.density[i] = rho < wall_rho0 ? wall_rho0 : rho;
+      // DBC walls never fall below zero absolute pressure (TaitEos::no_tension_density).
+      P.density[i] = rho < wall_rho_min ? wall_rho_min : rho;
     }
   }
 };

@@ -93,3 +93,19 @@ TEST(EosTait, HydrostaticDensityGivesHydrostaticPressure) {
 }
 
 }  // namespace
+
+// The walls' lower bound (sph/eos.hpp, no_tension_density): zero absolute pressure. Reference: the
+// analytic inverse, p(rho_min) = 0; without background pressure it is rest density exactly (so
+// scenes without one keep the clamp at rho0 bit for bit), with one it lies below rho0.
+TEST(EosTait, NoTensionDensityIsZeroAbsolutePressure) {
+  for (const auto& c : kCases) {
+    const TaitEos e = TaitEos::make(c.rho0, c.c0, c.gamma, c.pb);
+    const Real rho_min = e.no_tension_density();
+    EXPECT_NEAR(e.pressure(rho_min), 0.0, 1e-5 * e.stiffness) << "p_b = " << c.pb;
+    if (c.pb == 0.0) {
+      EXPECT_EQ(rho_min, e.rest_density);
+    } else {
+      EXPECT_LT(rho_min, e.rest_density);
+    }
+  }
+}

@@ -288,7 +288,7 @@ class CpuBackend final : public Backend {
   template <int D>
   void drift_impl(Real dt) {
     parallel_for(std::uint32_t(store_->size()),
-                 DriftPass<D>{view<D>(), dt, params_.materials[params_.wall_material].eos.rest_density});
+                 DriftPass<D>{view<D>(), dt, params_.materials[params_.wall_material].eos.no_tension_density()});
   }
 
   template <int D>

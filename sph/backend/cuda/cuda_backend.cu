@@ -237,9 +237,9 @@ class CudaBackend final : public Backend {
   }
 
   void drift(double dt) override {
-    const Real wall_rho0 = params_.materials[params_.wall_material].eos.rest_density;
-    if (params_.dimensions == 2) launch("DriftPass<2>", n_, DriftPass<2>{view<2>(), Real(dt), wall_rho0});
-    else launch("DriftPass<3>", n_, DriftPass<3>{view<3>(), Real(dt), wall_rho0});
+    const Real wall_rho_min = params_.materials[params_.wall_material].eos.no_tension_density();
+    if (params_.dimensions == 2) launch("DriftPass<2>", n_, DriftPass<2>{view<2>(), Real(dt), wall_rho_min});
+    else launch("DriftPass<3>", n_, DriftPass<3>{view<3>(), Real(dt), wall_rho_min});
   }
 
   // Conversions at open boundaries run on the host (few particles change; the store is copied
