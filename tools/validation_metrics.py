@@ -16,6 +16,8 @@ step when a definition changes.
                        C_L - mean C_L) over the last 2 s, against 3.23, 1.00 and 0.30.
   buoyancy_2d          largest relative error of the mean vertical force (t >= 1 s) on the box
                        and the cylinder against rho0 g V.
+  buoyancy_3d          the same for the cube and the cylinder of scenes/buoyancy_3d.yaml,
+                       mean over 0.6 s <= t <= 1 s.
 
 Run as a script, it plots the dam-break front of one or more runs against the experiment:
 
@@ -186,10 +188,10 @@ DFG_CD = 5.57953523384
 DFG_FROM = 2.5  # s: the wake has formed
 
 
-def forces_mean(run_dir, column, t_from):
+def forces_mean(run_dir, column, t_from, t_to=None):
     f = read_csv(os.path.join(run_dir, "forces.csv"))
     t = f["time [s]"]
-    vals = [v for tt, v in zip(t, f[column]) if tt >= t_from]
+    vals = [v for tt, v in zip(t, f[column]) if tt >= t_from and (t_to is None or tt <= t_to)]
     if not vals:
         raise ValueError(f"{run_dir}: no forces.csv rows after t = {t_from} s")
     return sum(vals) / len(vals)
@@ -232,13 +234,17 @@ def dfg2_error(run_dir):
     return max(abs(v[k] - ref) / ref for k, ref in DFG2_REFERENCE.items())
 
 
-def buoyancy_error(run_dir):
-    volumes = {"box": 0.2 * 0.2, "cylinder": math.pi * 0.1 * 0.1}
+def buoyancy_error(run_dir, volumes=None, column="Fy [N/m]", t_from=1.0, t_to=None):
+    """Largest relative error of the mean vertical force against rho0 g V over the bodies."""
+    volumes = volumes or {"box": 0.2 * 0.2, "cylinder": math.pi * 0.1 * 0.1}
     worst = 0.0
     for name, v in volumes.items():
         expected = HYDROSTATIC_DENSITY * GRAVITY * v
-        worst = max(worst, abs(forces_mean(run_dir, f"{name}.Fy [N/m]", 1.0) - expected) / expected)
+        worst = max(worst, abs(forces_mean(run_dir, f"{name}.{column}", t_from, t_to) - expected) / expected)
     return worst
+
+
+BUOYANCY_3D_VOLUMES = {"cube": 0.15 ** 3, "cylinder": math.pi * 0.075 ** 2 * 0.3}
 
 
 METRICS = {
@@ -256,6 +262,11 @@ METRICS = {
     "buoyancy_2d": {
         "description": "largest relative error of the mean F_y (t >= 1 s) vs rho0 g V (box, cylinder)",
         "error": buoyancy_error,
+        "extra": {},
+    },
+    "buoyancy_3d": {
+        "description": "largest relative error of the mean F_z (0.6 s <= t <= 1 s) vs rho0 g V (cube, cylinder)",
+        "error": lambda d: buoyancy_error(d, BUOYANCY_3D_VOLUMES, "Fz [N]", 0.6, 1.0),
         "extra": {},
     },
     "dam_break_2d": {
