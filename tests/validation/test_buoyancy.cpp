@@ -45,14 +45,9 @@ struct Body {
 // `unit` is the force unit of the columns ("N/m" in 2D, "N" in 3D), `up` the vertical axis.
 void check_buoyancy(const std::string& scene, double dx, double t_from, const std::vector<Body>& bodies,
                     const std::string& unit, const std::string& up, const std::vector<std::string>& sideways) {
-  const fs::path out = fs::temp_directory_path() / ("turbid_validation_" + scene + "_" + std::to_string(::getpid()));
-  fs::remove_all(out);
-  turbid::tools::RunRequest request;
-  request.scene_file = fs::path(TURBID_SOURCE_DIR) / "scenes" / (scene + ".yaml");
-  request.out = out;
-  request.spacing = dx;
-  request.progress = false;
-  const auto report = turbid::tools::run_scene(request);
+  const auto run = turbid::validation::run_scene_file(scene, dx);
+  const fs::path& out = run.out;
+  const auto& report = run.report;
   ASSERT_EQ(report.at("status").get<std::string>(), "completed") << report.dump(2);
 
   auto forces = read_csv(out / "forces.csv");

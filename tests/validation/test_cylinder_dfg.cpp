@@ -33,15 +33,9 @@ TEST(ValidationCylinderDfg, DragCoefficientMatchesSchaeferTurek2D1) {
   const double from = 2.5;
   const double tolerance = 0.05;
   const double reference = 5.57953523384;
-  const fs::path out = fs::temp_directory_path() / ("turbid_validation_dfg_" + std::to_string(::getpid()));
-  fs::remove_all(out);
-  turbid::tools::RunRequest request;
-  request.scene_file = fs::path(TURBID_SOURCE_DIR) / "scenes" / "cylinder_2d_re20.yaml";
-  request.out = out;
-  request.spacing = dx;
-  request.end_time = end;
-  request.progress = false;
-  const auto report = turbid::tools::run_scene(request);
+  const auto run = turbid::validation::run_scene_file("cylinder_2d_re20", dx, end);
+  const fs::path& out = run.out;
+  const auto& report = run.report;
   ASSERT_EQ(report.at("status").get<std::string>(), "completed") << report.dump(2);
   EXPECT_EQ(report.at("removed_particles").get<std::uint64_t>(), 0u) << "particles lost outside the open boundaries";
   const double in = double(report.at("inflow_particles").get<std::uint64_t>());

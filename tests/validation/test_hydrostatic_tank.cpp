@@ -46,17 +46,9 @@ double hydrostatic_pressure(double y) { return kDensity * kGravity * (kDepth - y
 
 TEST(ValidationHydrostaticTank, PressureIsHydrostaticAndWaterStaysAtRest) {
   const double dx = full_mode() ? 0.02 : kQuickSpacing;
-  const fs::path out =
-      fs::temp_directory_path() / ("turbid_validation_hydrostatic_" + std::to_string(::getpid()));
-  fs::remove_all(out);
-
-  turbid::tools::RunRequest request;
-  request.scene_file = fs::path(TURBID_SOURCE_DIR) / "scenes" / "hydrostatic_tank_2d.yaml";
-  request.out = out;
-  request.spacing = dx;
-  request.end_time = kEndTime;
-  request.progress = false;
-  const auto report = turbid::tools::run_scene(request);
+  const auto run = turbid::validation::run_scene_file("hydrostatic_tank_2d", dx, kEndTime);
+  const fs::path& out = run.out;
+  const auto& report = run.report;
   ASSERT_EQ(report.at("status").get<std::string>(), "completed") << report.dump(2);
   EXPECT_NEAR(report.at("simulated_time").get<double>(), kEndTime, 1e-3);
 

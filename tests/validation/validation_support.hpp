@@ -1,4 +1,5 @@
-// Helpers shared by the validation tests: quick/full mode and reading the CSV files runs write.
+// Helpers shared by the validation tests: quick/full mode, running a scene of scenes/ and reading
+// the CSV files runs write.
 #pragma once
 #include <cstdlib>
 #include <filesystem>
@@ -7,7 +8,10 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <unistd.h>
 #include <vector>
+
+#include "tools/runner.hpp"
 
 namespace turbid::validation {
 
@@ -15,6 +19,27 @@ namespace turbid::validation {
 inline bool full_mode() {
   const char* v = std::getenv("TURBID_FULL");
   return v != nullptr && std::string(v) == "1";
+}
+
+// Runs scenes/<scene>.yaml at spacing dx (and to end time `end` when > 0), without progress line,
+// into a fresh directory `out` under the system's temporary directory (named after the scene and
+// this process); `report` is run.json as the runner returns it.
+struct SceneRun {
+  std::filesystem::path out;
+  nlohmann::json report;
+};
+inline SceneRun run_scene_file(const std::string& scene, double dx, double end = 0) {
+  SceneRun run;
+  run.out = std::filesystem::temp_directory_path() / ("turbid_validation_" + scene + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(run.out);
+  tools::RunRequest request;
+  request.scene_file = std::filesystem::path(TURBID_SOURCE_DIR) / "scenes" / (scene + ".yaml");
+  request.out = run.out;
+  request.spacing = dx;
+  if (end > 0) request.end_time = end;
+  request.progress = false;
+  run.report = tools::run_scene(request);
+  return run;
 }
 
 // Columns of a CSV file with a header line; lines starting with '#' are skipped.
