@@ -5,7 +5,6 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -180,8 +179,6 @@ class StructureCarver {
     for (const auto& s : solids_) best = std::min(best, s.signed_distance(p, cutoff));
     return best;
   }
-
-  bool empty() const { return solids_.empty(); }
 
  private:
   std::vector<geometry::Solid> solids_;
