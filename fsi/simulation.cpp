@@ -168,9 +168,7 @@ class StructureCarver {
   bool blocks(const Point& p) const {
     const double limit = 0.5 * dx_ * (1.0 - 1e-6);
     // Cut-off dx > limit: the early exits of the meshes still decide "< limit" exactly.
-    for (const auto& s : solids_)
-      if (s.signed_distance(p, dx_) < limit) return true;
-    return false;
+    return distance(p, dx_) < limit;
   }
 
   // The smallest signed distance of p to the structures, exact where it is below `cutoff`.
