@@ -265,6 +265,10 @@ sph::PhysicsParams physics_params(const Scene& scene) {
   p.viscosity = scene.numerics.viscosity == ViscosityKind::laminar ? sph::Viscosity::laminar : sph::Viscosity::artificial;
   p.diffusion_delta = sph::Real(scene.numerics.diffusion_delta);
   p.artificial_viscosity = sph::Real(scene.numerics.artificial_viscosity);
+  p.shifting_coefficient = sph::Real(scene.numerics.shifting_coefficient);
+  p.shifting_surface_threshold = sph::Real(scene.numerics.shifting_surface_threshold < 0
+                                               ? scene.dimensions - 0.5
+                                               : scene.numerics.shifting_surface_threshold);
   p.smoothing_length = sph::Real(scene.smoothing_ratio * scene.particle_spacing);
   p.uniform_h = true;
   p.max_smoothing_length = p.smoothing_length;

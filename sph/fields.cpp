@@ -36,6 +36,10 @@ FieldIds register_fields(ParticleStore& s, const PhysicsParams& p, bool structur
     f.body = s.add_field({"body", "", ScalarType::u8, 1, true, true, true, Carry::copy});
     f.structure_force = s.add_field({"structure_force", force_unit, ScalarType::f32, d, true, false, false, Carry::recompute});
   }
+  // Computed by the momentum pass after each sort and used by the next drift, like the
+  // acceleration by the next half-kick: checkpointed for a bit-identical resume.
+  if (p.shifting_coefficient > 0)
+    f.shifting_velocity = s.add_field({"shifting_velocity", "m/s", ScalarType::f32, d, false, true, false, Carry::recompute});
   if (p.zone_count > 0) f.zone = s.add_field({"zone", "", ScalarType::u8, 1, true, true, true, Carry::copy});
   return f;
 }

@@ -14,6 +14,7 @@ struct FieldIds {
   FieldId viscous_velocity = -1;  // registered only for no-slip mDBC
   FieldId body = -1, structure_force = -1;  // registered only when the scene has structures
   FieldId zone = -1;                        // registered only with open boundaries
+  FieldId shifting_velocity = -1;           // registered only with particle shifting
 };
 
 // Registers what `params` needs (a water-only run with Fourtakas diffusion gets no gradient field).

@@ -36,6 +36,7 @@ struct ParticleView {
   std::uint8_t* body = nullptr;        // only with structures: structure index (kNoBody for others)
   std::uint8_t* zone = nullptr;        // only with open boundaries: buffer zone index (kNoZone for others)
   Vec<D>* viscous_velocity = nullptr;  // only with no-slip mDBC: the velocity walls show the viscous terms
+  Vec<D>* shifting_velocity = nullptr; // only with particle shifting: u_s of fluid particles, added in the drift
   // CPU only: positions as one array per coordinate (component a at a * soa_stride), a copy made
   // at each sort so that distance checks vectorise; valid until the next drift.
   const Real* position_soa = nullptr;
@@ -167,6 +168,7 @@ struct DriftPass {
     const Real rho = P.density[i] + dt * P.density_rate[i];
     if (P.kind[i] == std::uint8_t(Kind::fluid)) {
       P.position[i] += dt * P.velocity[i];
+      if (P.shifting_velocity) P.position[i] += dt * P.shifting_velocity[i];
       P.density[i] = rho;
     } else if (P.kind[i] == std::uint8_t(Kind::buffer)) {
       P.position[i] += dt * P.velocity[i];  // density and velocity: BufferPass
@@ -481,18 +483,55 @@ struct MomentumPass {
     const bool artificial = prm.viscosity == Viscosity::artificial;
 #if !defined(__CUDA_ARCH__)
     if constexpr (UniformH) {
-      if (artificial && P.viscous_velocity == nullptr && lanes(i, xi, vi, rho_i, p_i, Mi, acc)) {
+      if (artificial && P.viscous_velocity == nullptr && P.shifting_velocity == nullptr &&
+          lanes(i, xi, vi, rho_i, p_i, Mi, acc)) {
         for (int k = 0; k < D; ++k) acc[k] += prm.gravity[k];
         P.acceleration[i] = acc;
         return;
       }
     }
 #endif
-    for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
-      acc += momentum_pair<D, K, UniformH>(P, prm, vi, rho_i, p_i, h_i, Mi, j, rij, r2);
-    });
+    if (P.shifting_velocity) {
+      // Particle shifting: grad C_i = sum_j V_j grad_i W_ij over all neighbours
+      // (walls included, so a wall does not look like a free surface) and the position divergence.
+      // The velocity gradient grad v_i = sum_j V_j (v_j - v_i) (x) grad_i W_ij gives the particle the
+      // velocity of the place it is shifted to (first-order Taylor correction, Lind et al. 2012):
+      // a += (u_s . grad) v, so shifting does not smear momentum across a shear layer.
+      Vec<D> grad_c = Vec<D>::zero();
+      Real div_r = 0;
+      Real grad_v[D][D] = {};
+      for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
+        acc += momentum_pair<D, K, UniformH>(P, prm, vi, rho_i, p_i, h_i, Mi, j, rij, r2);
+        const Real h = pair_h<D, K>(P, prm, UniformH, h_i, j);
+        if (!UniformH && r2 >= Real(4) * h * h) return;
+        const Real FV = K::f_inv(std::sqrt(r2), Real(1) / h) * P.mass[j] / P.density[j];
+        grad_c += FV * rij;
+        div_r -= FV * r2;
+        const bool mirrored = P.viscous_velocity != nullptr && (P.kind[j] == std::uint8_t(Kind::wall) ||
+                                                                P.kind[j] == std::uint8_t(Kind::structure));
+        const Vec<D> vji = (mirrored ? P.viscous_velocity[j] : P.velocity[j]) - vi;
+        for (int a = 0; a < D; ++a)
+          for (int b = 0; b < D; ++b) grad_v[a][b] += vji[a] * FV * rij[b];
+      });
+      const Vec<D> us = shifting_velocity(prm, h_i, vi, grad_c, div_r);
+      P.shifting_velocity[i] = us;
+      for (int a = 0; a < D; ++a)
+        for (int b = 0; b < D; ++b) acc[a] += us[b] * grad_v[a][b];
+    } else {
+      for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
+        acc += momentum_pair<D, K, UniformH>(P, prm, vi, rho_i, p_i, h_i, Mi, j, rij, r2);
+      });
+    }
     for (int k = 0; k < D; ++k) acc[k] += prm.gravity[k];
     P.acceleration[i] = acc;
+  }
+
+  // u_s = -A h |v| grad C (Skillen et al. 2013); zero at a free surface (div r below the threshold),
+  // where grad C points into the fluid and shifting would pull the surface inwards.
+  TURBID_HD static Vec<D> shifting_velocity(const PhysicsParams& prm, Real h, const Vec<D>& v, const Vec<D>& grad_c,
+                                            Real div_r) {
+    if (div_r < prm.shifting_surface_threshold) return Vec<D>::zero();
+    return (-prm.shifting_coefficient * h * std::sqrt(norm2(v))) * grad_c;
   }
 
   // CPU: the same sums (uniform h, artificial viscosity) in W independent lanes, so that the

@@ -64,6 +64,12 @@ struct PhysicsParams {
   BufferZone zones[kMaxZones];
   Real diffusion_delta = Real(0.1);
   Real artificial_viscosity = Real(0.01);
+  // Particle shifting (Lind et al. 2012, coefficient form of Skillen et al. 2013): fluid particles
+  // drift with v + u_s, u_s = -A h |v| grad C. A = 0: off (no pass, no field).
+  Real shifting_coefficient = 0;
+  // A particle whose position divergence div r = -sum_j V_j r_ij . grad_i W_ij (= D inside the
+  // fluid) is below this is at a free surface and is not shifted; 0: no detection (internal flows).
+  Real shifting_surface_threshold = 0;
   Real smoothing_length = 0;   // h of the initial lattice [m]
   bool uniform_h = true;       // every particle has h == smoothing_length (fast path)
   Real max_smoothing_length = 0;  // largest h present [m]; the neighbour search covers 2 h_max

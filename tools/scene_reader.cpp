@@ -478,7 +478,8 @@ fsi::Scene Reader::read(const std::string& yaml_text) {
 }
 
 void Reader::read_numerics(const Value& v, fsi::NumericsSpec& n) const {
-  MapView m(*this, v, {"kernel", "density_diffusion", "viscosity", "boundary", "min_time_step", "max_density_variation"});
+  MapView m(*this, v, {"kernel", "density_diffusion", "viscosity", "boundary", "shifting", "min_time_step",
+                                "max_density_variation"});
   if (auto bv = m.get("boundary")) {
     MapView b(*this, *bv, {"type", "velocity"});
     n.boundary = choice(b.need("type"), {"dbc", "mdbc"}) == 0 ? fsi::BoundaryKind::dbc : fsi::BoundaryKind::mdbc;
@@ -512,6 +513,13 @@ void Reader::read_numerics(const Value& v, fsi::NumericsSpec& n) const {
              "'alpha' applies only to 'artificial' viscosity; 'laminar' uses each material's 'viscosity'");
       n.artificial_viscosity = number(*alpha, non_negative());
     }
+  }
+  if (auto sv = m.get("shifting")) {
+    // Particle shifting (Lind et al. 2012; Skillen et al. 2013): A of about 2 keeps the particles
+    // evenly spread where the flow pulls them apart (wakes, internal flows).
+    MapView s(*this, *sv, {"coefficient", "free_surface_threshold"});
+    n.shifting_coefficient = number(s.need("coefficient"), positive());
+    if (auto t = s.get("free_surface_threshold")) n.shifting_surface_threshold = number(*t, non_negative());
   }
   if (auto t = m.get("min_time_step")) n.min_time_step = number(*t, positive(), "s");
   // |rho / rho0 - 1| above this stops the run as a blow-up.

@@ -49,12 +49,12 @@ turbid::tools::RunRequest request(const fs::path& scene, const fs::path& out) {
 
 }  // namespace
 
-TEST(CheckpointResume, ResumedRunIsBitIdenticalToUninterruptedRun) {
+void check_resume(const std::string& scene_text) {
   const fs::path dir = fs::temp_directory_path() / ("turbid_resume_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path scene = dir / "scene.yaml";
-  std::ofstream(scene) << kScene;
+  std::ofstream(scene) << scene_text;
 
   // Uninterrupted run to 0.06 s.
   const auto full = turbid::tools::run_scene(request(scene, dir / "full"));
@@ -89,4 +89,12 @@ TEST(CheckpointResume, ResumedRunIsBitIdenticalToUninterruptedRun) {
   EXPECT_EQ(slurp(dir / "full" / "probes.csv"), slurp(dir / "split" / "probes.csv"));
   EXPECT_EQ(slurp(dir / "full" / "particles.pvd"), slurp(dir / "split" / "particles.pvd"));
   fs::remove_all(dir);
+}
+
+TEST(CheckpointResume, ResumedRunIsBitIdenticalToUninterruptedRun) { check_resume(kScene); }
+
+// With particle shifting the next drift uses the shifting velocity of the last force pass, which
+// the checkpoint must therefore hold (like the acceleration).
+TEST(CheckpointResume, ResumedRunWithShiftingIsBitIdentical) {
+  check_resume(std::string(kScene) + "numerics: {shifting: {coefficient: 2.0}}\n");
 }

@@ -191,6 +191,24 @@ TEST(SceneReader, EmptyOrMultiDocumentTextIsRefused) {
             std::string::npos);
 }
 
+// Particle shifting: off unless the scene asks; the coefficient is required, the free-surface
+// threshold optional (the engine's default D - 1/2 when absent, marked by -1 here).
+TEST(SceneReader, ShiftingIsReadWithItsCoefficientAndThreshold) {
+  const std::string head =
+      "name: t\ndimensions: 2\nresolution: {particle_spacing: 0.01}\n"
+      "time: {end: 0.1}\nmaterials: {water: {density: 1000}}\nfluids: [{material: water, box: {min: [0, 0], max: [0.1, 0.1]}}]\n";
+  EXPECT_EQ(read_scene_string(head, "a.yaml").numerics.shifting_coefficient, 0.0);
+  const auto s = read_scene_string(head + "numerics: {shifting: {coefficient: 2.5, free_surface_threshold: 0}}\n", "b.yaml");
+  EXPECT_DOUBLE_EQ(s.numerics.shifting_coefficient, 2.5);
+  EXPECT_DOUBLE_EQ(s.numerics.shifting_surface_threshold, 0.0);
+  EXPECT_DOUBLE_EQ(read_scene_string(head + "numerics: {shifting: {coefficient: 2}}\n", "c.yaml")
+                       .numerics.shifting_surface_threshold, -1.0);
+  const std::string missing = error_of_string(head + "numerics: {shifting: {free_surface_threshold: 1.5}}\n", "d.yaml");
+  EXPECT_EQ(missing.rfind("d.yaml:7:22: error: missing required key 'coefficient' in 'shifting'", 0), 0u) << missing;
+  const std::string negative = error_of_string(head + "numerics: {shifting: {coefficient: -1}}\n", "e.yaml");
+  EXPECT_NE(negative.find("'coefficient' must be a positive number"), std::string::npos) << negative;
+}
+
 // The 2D good scene: every section given with non-default values, checked against the file.
 TEST(SceneReader, GoodDamBreak2dParsesToTheWrittenValues) {
   const std::string path = kData + "/good_scenes/dam_break_2d.yaml";

@@ -143,6 +143,7 @@ class CpuBackend final : public Backend {
     if (ids_.body >= 0) v.body = s.data<std::uint8_t>(ids_.body);
     if (ids_.zone >= 0) v.zone = s.data<std::uint8_t>(ids_.zone);
     if (ids_.viscous_velocity >= 0) v.viscous_velocity = s.data<Vec<D>>(ids_.viscous_velocity);
+    if (ids_.shifting_velocity >= 0) v.shifting_velocity = s.data<Vec<D>>(ids_.shifting_velocity);
     v.count = std::uint32_t(s.size());
     if (soa_valid_) {
       v.position_soa = soa_.data();

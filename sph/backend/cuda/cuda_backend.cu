@@ -366,6 +366,7 @@ class CudaBackend final : public Backend {
     if (ids_.body >= 0) v.body = static_cast<std::uint8_t*>(field(ids_.body));
     if (ids_.zone >= 0) v.zone = static_cast<std::uint8_t*>(field(ids_.zone));
     if (ids_.viscous_velocity >= 0) v.viscous_velocity = static_cast<Vec<D>*>(field(ids_.viscous_velocity));
+    if (ids_.shifting_velocity >= 0) v.shifting_velocity = static_cast<Vec<D>*>(field(ids_.shifting_velocity));
     v.count = n_;
     return v;
   }
