@@ -24,11 +24,19 @@ enum class DiffusionKind { none, molteni, antuono, fourtakas };
 enum class ViscosityKind { artificial, laminar };
 enum class BoundaryKind { dbc, mdbc };  // wall treatment; see docs/choices.md
 
+// A material's rheology (physics.md C8): newtonian (viscosity), bingham (yield_stress and the
+// plastic viscosity in `viscosity`), or herschel_bulkley (yield_stress, consistency, flow_index);
+// the yield-stress models are regularised by Papanastasiou's exponent m.
 struct MaterialSpec {
   std::string name;
-  std::string model = "newtonian";  // later: bingham, herschel_bulkley
+  std::string model = "newtonian";  // newtonian | bingham | herschel_bulkley
   double density = 1000.0;          // rest density rho0 [kg/m^3]
-  double viscosity = 1.0e-3;        // dynamic viscosity [Pa s]
+  double viscosity = 1.0e-3;        // dynamic viscosity [Pa s]; bingham: plastic viscosity mu_B
+  double yield_stress = 0.0;        // tau_y [Pa]
+  double consistency = 0.0;         // herschel_bulkley: K [Pa s^n]
+  double flow_index = 1.0;          // herschel_bulkley: n [-]
+  double papanastasiou_exponent = 0.0;  // m [s]
+  double max_viscosity = 0.0;       // cap on mu_eff [Pa s]; 0 = automatic (docs/choices.md)
   double sound_speed = 0.0;         // c0 [m/s]; 0 = automatic (10 x sqrt(2 g H_max))
   double gamma = 7.0;               // Tait exponent [-]
   double background_pressure = 0.0; // p_b [Pa]
@@ -173,6 +181,8 @@ struct Scene {
   // Particles leaving this box are removed and counted. Default: the bounding box of all
   // initial particles, grown by 10% of its size on every side.
   std::optional<Box> domain;
+  // Axes along which the domain is periodic (needs `domain`; its extent is the period).
+  std::array<bool, 3> periodic{false, false, false};
 };
 
 }  // namespace turbid::fsi

@@ -252,6 +252,15 @@ int wall_layers(const Scene& scene, const WallSpec& wall) {
   return std::max(1, int(std::ceil(2.0 * scene.smoothing_ratio - 1e-9)));
 }
 
+// The cap on a non-Newtonian material's mu_eff: as given, or the viscosity whose viscous time-step
+// limit f h^2 rho0 / mu equals the acoustic one CFL h / c0, so that the (nearly rigid) unyielded
+// regions, where HBP's mu_eff tends to m tau_y, do not make dt collapse (docs/choices.md).
+static double max_viscosity(const Scene& scene, const MaterialSpec& m, double sound_speed) {
+  if (m.max_viscosity > 0) return m.max_viscosity;
+  const double h = scene.smoothing_ratio * scene.particle_spacing;
+  return scene.numerics.viscous_dt_factor * h * m.density * sound_speed / scene.numerics.cfl;
+}
+
 sph::PhysicsParams physics_params(const Scene& scene) {
   sph::PhysicsParams p;
   p.dimensions = scene.dimensions;
@@ -288,11 +297,32 @@ sph::PhysicsParams physics_params(const Scene& scene) {
     p.materials[m].eos = sph::TaitEos::make(ms.density, c0, ms.gamma, ms.background_pressure);
     p.materials[m].sound_speed = sph::Real(c0);
     p.materials[m].dynamic_viscosity = sph::Real(ms.viscosity);
+    p.materials[m].rheology.consistency = sph::Real(ms.viscosity);
+    if (ms.model != "newtonian") {
+      sph::Rheology& r = p.materials[m].rheology;
+      r.yield_stress = sph::Real(ms.yield_stress);
+      r.consistency = sph::Real(ms.model == "bingham" ? ms.viscosity : ms.consistency);
+      r.flow_index = sph::Real(ms.model == "bingham" ? 1.0 : ms.flow_index);
+      r.regularisation = sph::Real(ms.papanastasiou_exponent);
+      r.max_viscosity = sph::Real(max_viscosity(scene, ms, c0));
+      // The viscous time-step limit and the boundary terms see the largest mu_eff possible.
+      p.materials[m].dynamic_viscosity = r.max_viscosity;
+      p.materials[m].non_newtonian = true;
+      p.rheology = true;
+    }
   }
   p.wall_material = 0;
   p.uniform_sound_speed = true;
   for (int m = 1; m < p.material_count; ++m)
     p.uniform_sound_speed = p.uniform_sound_speed && p.materials[m].sound_speed == p.materials[0].sound_speed;
+  if (scene.domain) {
+    for (int k = 0; k < scene.dimensions; ++k) {
+      if (!scene.periodic[std::size_t(k)]) continue;
+      p.periodic = true;
+      p.period[k] = sph::Real(scene.domain->max[std::size_t(k)] - scene.domain->min[std::size_t(k)]);
+      p.periodic_origin[k] = sph::Real(scene.domain->min[std::size_t(k)]);
+    }
+  }
   p.boundary = scene.numerics.boundary == BoundaryKind::mdbc ? sph::Boundary::mdbc : sph::Boundary::dbc;
   p.mdbc_no_slip = scene.numerics.no_slip;
   p.body_count = int(scene.structures.size());
@@ -532,6 +562,7 @@ void Simulation::build_particles() {
     for (int k = 0; k < 3; ++k) {
       summary_.domain.min[k] = s.domain->min[k];
       summary_.domain.max[k] = s.domain->max[k];
+      summary_.domain.periodic[k] = s.periodic[std::size_t(k)];
     }
   } else {
     double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};

@@ -11,17 +11,13 @@
 
 #include "sph/body_loads.hpp"
 #include "sph/fields.hpp"
+#include "sph/grid_layout.hpp"
 #include "sph/open_boundary.hpp"
 #include "sph/particle_store.hpp"
 #include "sph/physics_params.hpp"
 
 namespace turbid::sph {
 
-// Particles outside this box are removed at the next neighbour update.
-struct Domain {
-  double min[3] = {0, 0, 0};
-  double max[3] = {0, 0, 0};
-};
 
 struct StepStats {
   double max_speed = 0;         // largest fluid speed [m/s]

@@ -67,10 +67,11 @@ TURBID_HD inline Real ghost_interpolation(const ParticleView<D>& P, const GridVi
   Real A[N][N] = {};
   Real rhs[N] = {};
   Vec<D> vsum = Vec<D>::zero();
-  G.for_each_neighbour_range(c, [&](std::uint32_t j0, std::uint32_t j1) {
+  G.for_each_neighbour_range(c, [&](std::uint32_t j0, std::uint32_t j1, const Vec<D>& image) {
+    const Vec<D> xo = xg - image;
     for (std::uint32_t j = j0; j < j1; ++j) {
       const bool fluid = P.kind[j] == std::uint8_t(Kind::fluid);
-      const Vec<D> r = xg - P.position[j];  // x_g - x_j = -x_jg
+      const Vec<D> r = xo - P.position[j];  // x_g - x_j = -x_jg
       const Real r2 = norm2(r);
       if (r2 >= support2) continue;
       const Real h = UniformH ? prm.smoothing_length : Real(0.5) * (h_b + P.smoothing_length[j]);
@@ -224,9 +225,10 @@ struct StructureForcePass {
         if (P.kind[i] != std::uint8_t(Kind::fluid)) return;
         const Real h_i = UniformH ? prm.smoothing_length : P.smoothing_length[i];
         const MaterialParams& Mi = prm.materials[P.material[i]];
+        const Real mu_i = P.effective_viscosity ? P.effective_viscosity[i] : Mi.dynamic_viscosity;
         const Vec<D> rib = Real(-1) * rbi;
-        const Vec<D> a = momentum_pair<D, K, UniformH>(P, prm, P.velocity[i], P.density[i], P.pressure[i], h_i, Mi, b,
-                                                       rib, r2);
+        const Vec<D> a = momentum_pair<D, K, UniformH>(P, prm, P.velocity[i], P.density[i], P.pressure[i], h_i, Mi, mu_i,
+                                                       b, rib, r2);
         f -= P.mass[i] * a;
       });
     }

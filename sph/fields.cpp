@@ -40,6 +40,13 @@ FieldIds register_fields(ParticleStore& s, const PhysicsParams& p, bool structur
   // acceleration by the next half-kick: checkpointed for a bit-identical resume.
   if (p.shifting_coefficient > 0)
     f.shifting_velocity = s.add_field({"shifting_velocity", "m/s", ScalarType::f32, d, false, true, false, Carry::recompute});
+  // Recomputed by the rheology pass after every sort, before the momentum pass reads them.
+  if (p.rheology) {
+    f.shear_rate = s.add_field({"shear_rate", "1/s", ScalarType::f32, 1, true, false, false, Carry::recompute});
+    f.effective_viscosity =
+        s.add_field({"effective_viscosity", "Pa s", ScalarType::f32, 1, true, false, false, Carry::recompute});
+    f.shear_stress = s.add_field({"shear_stress", "Pa", ScalarType::f32, 1, true, false, false, Carry::recompute});
+  }
   if (p.zone_count > 0) f.zone = s.add_field({"zone", "", ScalarType::u8, 1, true, true, true, Carry::copy});
   return f;
 }

@@ -15,6 +15,7 @@ struct FieldIds {
   FieldId body = -1, structure_force = -1;  // registered only when the scene has structures
   FieldId zone = -1;                        // registered only with open boundaries
   FieldId shifting_velocity = -1;           // registered only with particle shifting
+  FieldId shear_rate = -1, effective_viscosity = -1, shear_stress = -1;  // only with a non-Newtonian material
 };
 
 // Registers what `params` needs (a water-only run with Fourtakas diffusion gets no gradient field).

@@ -52,11 +52,21 @@ TURBID_HD inline Real artificial_viscosity(Real alpha, Real h, Real c_mean, Real
   return m_j * alpha * c_mean * h * vij_dot_rij * F / ((r2 + eta2) * rho_mean);
 }
 
+// Twice the viscosity of a pair, 2 mu_ij: the harmonic mean mu_ij = 2 mu_i mu_j / (mu_i + mu_j)
+// (Hu & Adams 2006, physics.md C10), which lets the less viscous side set the shear stress across
+// an interface, as for layers in series. Equal viscosities give mu_i + mu_j, bit for bit.
+TURBID_HD inline Real pair_viscosity_sum(Real mu_i, Real mu_j) {
+  if (mu_i == mu_j) return mu_i + mu_j;
+  const Real sum = mu_i + mu_j;
+  return sum > Real(0) ? Real(4) * mu_i * mu_j / sum : Real(0);
+}
+
 // Morris, Fox & Zhu (1997) laminar viscosity: a_i += s v_ij with
-// s = m_j (mu_i + mu_j) r_ij . grad_i W / (rho_i rho_j (r^2 + eta^2)).
+// s = m_j 2 mu_ij r_ij . grad_i W / (rho_i rho_j (r^2 + eta^2)). With a viscosity per particle
+// (generalised Newtonian rheology) this is the SPH form of div(mu grad v).
 TURBID_HD inline Real laminar_viscosity(Real m_j, Real mu_i, Real mu_j, Real rho_i, Real rho_j, Real r2, Real eta2,
                                         Real F) {
-  return m_j * (mu_i + mu_j) * F * r2 / (rho_i * rho_j * (r2 + eta2));
+  return m_j * pair_viscosity_sum(mu_i, mu_j) * F * r2 / (rho_i * rho_j * (r2 + eta2));
 }
 
 }  // namespace turbid::sph::pair

@@ -13,6 +13,7 @@
 #include "sph/neighbour_grid.hpp"
 #include "sph/pair_physics.hpp"
 #include "sph/physics_params.hpp"
+#include "sph/rheology.hpp"
 #include "sph/vec.hpp"
 
 namespace turbid::sph {
@@ -37,6 +38,9 @@ struct ParticleView {
   std::uint8_t* zone = nullptr;        // only with open boundaries: buffer zone index (kNoZone for others)
   Vec<D>* viscous_velocity = nullptr;  // only with no-slip mDBC: the velocity walls show the viscous terms
   Vec<D>* shifting_velocity = nullptr; // only with particle shifting: u_s of fluid particles, added in the drift
+  Real* shear_rate = nullptr;          // only with a non-Newtonian material: sqrt(2 D:D) [1/s]
+  Real* effective_viscosity = nullptr; // only with a non-Newtonian material: mu_eff [Pa s]
+  Real* shear_stress = nullptr;        // only with a non-Newtonian material: sqrt(J2(tau)) = mu_eff gamma_dot [Pa]
   // CPU only: positions as one array per coordinate (component a at a * soa_stride), a copy made
   // at each sort so that distance checks vectorise; valid until the next drift.
   const Real* position_soa = nullptr;
@@ -46,6 +50,21 @@ struct ParticleView {
 
 // Eta^2 = 0.01 h^2 regularises 1/r^2 terms (Monaghan 1992).
 inline constexpr Real kEta2Factor = Real(0.01);
+
+// The pair vector to the nearest periodic image, for vectors not taken from a grid range (which
+// carries its image offset): neighbour lists, ghost nodes. Unchanged without periodic axes.
+template <int D>
+TURBID_HD inline Vec<D> nearest_image(const PhysicsParams& prm, Vec<D> r) {
+  if (!prm.periodic) return r;
+  for (int a = 0; a < D; ++a) {
+    const Real L = prm.period[a];
+    if (L > Real(0)) {
+      if (r[a] > Real(0.5) * L) r[a] -= L;
+      else if (r[a] < Real(-0.5) * L) r[a] += L;
+    }
+  }
+  return r;
+}
 
 template <int D, class K>
 TURBID_HD inline Real pair_h(const ParticleView<D>& P, const PhysicsParams& prm, bool uniform, Real h_i, std::uint32_t j) {
@@ -74,7 +93,7 @@ TURBID_HD inline void for_each_neighbour(const ParticleView<D>& P, const GridVie
     const std::uint32_t n = L.count[i];
     for (std::uint32_t k = 0; k < n; ++k) {
       const std::uint32_t j = list[k];
-      const Vec<D> rij = xi - P.position[j];
+      const Vec<D> rij = nearest_image<D>(prm, xi - P.position[j]);
       f(j, rij, norm2(rij));
     }
     return;
@@ -90,13 +109,14 @@ TURBID_HD inline void for_each_neighbour(const ParticleView<D>& P, const GridVie
     constexpr std::uint32_t kChunk = 64;
     Real d[D][kChunk];
     Real r2buf[kChunk];
-    G.for_each_neighbour_range(c, [&](std::uint32_t b, std::uint32_t e) {
+    G.for_each_neighbour_range(c, [&](std::uint32_t b, std::uint32_t e, const Vec<D>& offset) {
+      const Vec<D> xo = xi - offset;  // x_i against the image of the range's particles
       for (std::uint32_t b0 = b; b0 < e; b0 += kChunk) {
         const std::uint32_t len = e - b0 < kChunk ? e - b0 : kChunk;
         for (std::uint32_t k = 0; k < len; ++k) {
           Real r2 = 0;
           for (int a = 0; a < D; ++a) {
-            d[a][k] = xi[a] - P.position_soa[std::size_t(a) * P.soa_stride + b0 + k];
+            d[a][k] = xo[a] - P.position_soa[std::size_t(a) * P.soa_stride + b0 + k];
             r2 += d[a][k] * d[a][k];
           }
           r2buf[k] = r2;
@@ -123,9 +143,10 @@ TURBID_HD inline void for_each_neighbour(const ParticleView<D>& P, const GridVie
     return;
   }
 #endif
-  G.for_each_neighbour_range(c, [&](std::uint32_t b, std::uint32_t e) {
+  G.for_each_neighbour_range(c, [&](std::uint32_t b, std::uint32_t e, const Vec<D>& offset) {
+    const Vec<D> xo = xi - offset;
     for (std::uint32_t j = b; j < e; ++j) {
-      const Vec<D> rij = xi - P.position[j];
+      const Vec<D> rij = xo - P.position[j];
       const Real r2 = norm2(rij);
       if (r2 >= support2 || j == i) continue;
       if (out) {
@@ -164,11 +185,35 @@ struct DriftPass {
   ParticleView<D> P;
   Real dt;
   Real wall_rho_min;  // TaitEos::no_tension_density of the wall material
+  bool periodic = false;
+  Real lo[3] = {0, 0, 0}, period[3] = {0, 0, 0};
+
+  DriftPass(const ParticleView<D>& view, Real step, Real rho_min, const PhysicsParams& prm)
+      : P(view), dt(step), wall_rho_min(rho_min), periodic(prm.periodic) {
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = prm.periodic_origin[a];
+      period[a] = prm.period[a];
+    }
+  }
+  // Back into [lo, lo + period) on periodic axes (a fluid particle moves far less than a period
+  // per step). A coordinate that rounds onto the upper face goes to the lower one.
+  TURBID_HD Vec<D> wrap(Vec<D> x) const {
+    for (int a = 0; a < D; ++a) {
+      if (period[a] == Real(0)) continue;
+      const Real hi = lo[a] + period[a];
+      if (x[a] >= hi) x[a] -= period[a];
+      else if (x[a] < lo[a]) x[a] += period[a];
+      if (!(x[a] < hi)) x[a] = lo[a];
+    }
+    return x;
+  }
   TURBID_HD void operator()(std::uint32_t i) const {
     const Real rho = P.density[i] + dt * P.density_rate[i];
     if (P.kind[i] == std::uint8_t(Kind::fluid)) {
-      P.position[i] += dt * P.velocity[i];
-      if (P.shifting_velocity) P.position[i] += dt * P.shifting_velocity[i];
+      Vec<D> x = P.position[i] + dt * P.velocity[i];
+      if (P.shifting_velocity) x += dt * P.shifting_velocity[i];
+      if (periodic) x = wrap(x);
+      P.position[i] = x;
       P.density[i] = rho;
     } else if (P.kind[i] == std::uint8_t(Kind::buffer)) {
       P.position[i] += dt * P.velocity[i];  // density and velocity: BufferPass
@@ -275,11 +320,12 @@ struct LaneGeometry {
   alignas(32) Real r[D][kLaneNeighbours + kLanes];
   alignas(32) Real vr[kLaneNeighbours + kLanes];
 
-  void set(std::uint32_t k, const ParticleView<D>& P, const Vec<D>& xi, const Vec<D>& vi, std::uint32_t j, bool valid,
-           Real h) {
+  void set(std::uint32_t k, const ParticleView<D>& P, const PhysicsParams& prm, const Vec<D>& xi, const Vec<D>& vi,
+           std::uint32_t j, bool valid, Real h) {
+    const Vec<D> rij = nearest_image<D>(prm, xi - P.position[j]);
     Real dot_v = 0;
     for (int a = 0; a < D; ++a) {
-      const Real d = xi[a] - P.position[j][a];
+      const Real d = rij[a];
       r[a][k] = valid ? d : (a == 0 ? h : Real(0));
       dot_v += (vi[a] - P.velocity[j][a]) * d;
     }
@@ -394,7 +440,7 @@ struct ContinuityPass {
     for (std::uint32_t k = 0; k < padded; ++k) {
       const bool valid = k < m;
       const std::uint32_t j = valid ? nb[k] : i;
-      g.set(k, P, xi, vi, j, valid, h);
+      g.set(k, P, prm, xi, vi, j, valid, h);
       rho_j[k] = P.density[j];
       vol_j[k] = (valid ? P.mass[j] : Real(0)) / P.density[j];
       const bool s_mat = P.kind[j] == std::uint8_t(Kind::fluid) && P.material[j] == mat_i;
@@ -430,14 +476,66 @@ struct ContinuityPass {
   }
 };
 
+// The velocity particle j shows viscous terms: no-slip mDBC boundary particles show the mirrored
+// fluid velocity (viscous_velocity), every other particle its own.
+template <int D>
+TURBID_HD inline Vec<D> viscous_velocity_of(const ParticleView<D>& P, std::uint32_t j) {
+  const bool mirrored = P.viscous_velocity != nullptr &&
+                        (P.kind[j] == std::uint8_t(Kind::wall) || P.kind[j] == std::uint8_t(Kind::structure));
+  return mirrored ? P.viscous_velocity[j] : P.velocity[j];
+}
+
+// Generalised Newtonian rheology (physics.md C8), before the momentum pass: for every fluid
+// particle the velocity gradient in the first-order difference form
+//   (grad v)_i = sum_j V_j (v_j - v_i) (x) grad_i W_ij
+// over all neighbours (boundary particles with the velocity they show viscous terms, so the
+// shear at a no-slip wall is seen), the shear rate gamma_dot = sqrt(2 D:D) of its symmetric part,
+// mu_eff(gamma_dot) of the particle's material (capped at dynamic_viscosity) and the effective
+// shear stress sqrt(J2(tau)) = mu_eff gamma_dot of tau = 2 mu_eff D. The difference form is exact
+// for a uniform velocity whatever the particle arrangement; boundary particles get zeros.
+template <int D, class K, bool UniformH>
+struct RheologyPass {
+  ParticleView<D> P;
+  GridView<D> G;
+  PhysicsParams prm;
+
+  TURBID_HD void operator()(std::uint32_t i) const {
+    if (P.kind[i] != std::uint8_t(Kind::fluid)) {
+      P.shear_rate[i] = Real(0);
+      P.effective_viscosity[i] = Real(0);
+      P.shear_stress[i] = Real(0);
+      return;
+    }
+    const Vec<D> xi = P.position[i];
+    const Vec<D> vi = P.velocity[i];
+    const Real h_i = UniformH ? prm.smoothing_length : P.smoothing_length[i];
+    Real g[D][D] = {};
+    for_each_neighbour<D>(P, G, NeighbourList{}, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
+      const Real h = pair_h<D, K>(P, prm, UniformH, h_i, j);
+      if (!UniformH && r2 >= Real(4) * h * h) return;
+      const Real FV = K::f_inv(std::sqrt(r2), Real(1) / h) * P.mass[j] / P.density[j];
+      const Vec<D> vji = viscous_velocity_of<D>(P, j) - vi;
+      for (int a = 0; a < D; ++a)
+        for (int b = 0; b < D; ++b) g[a][b] += vji[a] * FV * rij[b];
+    });
+    const MaterialParams& M = prm.materials[P.material[i]];
+    const Real gamma_dot = shear_rate<D>(g);
+    const Real mu = M.non_newtonian ? M.rheology.effective_viscosity(gamma_dot) : M.dynamic_viscosity;
+    P.shear_rate[i] = gamma_dot;
+    P.effective_viscosity[i] = mu;
+    P.shear_stress[i] = mu * gamma_dot;
+  }
+};
+
 // Acceleration of fluid particle i (velocity vi, density rho_i, pressure p_i, smoothing length
-// h_i, material Mi) due to particle j at r_ij = x_i - x_j: pressure and viscosity (physics.md C10,
-// C2). The structure-force pass evaluates the same function for the same pair, so the force on a
+// h_i, material Mi, viscosity mu_i) due to particle j at r_ij = x_i - x_j: pressure and viscosity
+// (physics.md C10, C2). Boundary particles take the fluid's viscosity mu_i (no-slip in the fluid's
+// own rheology). The structure-force pass evaluates the same function for the same pair, so the force on a
 // structure is exactly the reaction of what it does to the fluid.
 template <int D, class K, bool UniformH>
 TURBID_HD inline Vec<D> momentum_pair(const ParticleView<D>& P, const PhysicsParams& prm, const Vec<D>& vi, Real rho_i,
-                                      Real p_i, Real h_i, const MaterialParams& Mi, std::uint32_t j, const Vec<D>& rij,
-                                      Real r2) {
+                                      Real p_i, Real h_i, const MaterialParams& Mi, Real mu_i, std::uint32_t j,
+                                      const Vec<D>& rij, Real r2) {
   const Real h = pair_h<D, K>(P, prm, UniformH, h_i, j);
   if (!UniformH && r2 >= Real(4) * h * h) return Vec<D>::zero();
   const Real F = K::f_inv(std::sqrt(r2), Real(1) / h);
@@ -445,10 +543,7 @@ TURBID_HD inline Vec<D> momentum_pair(const ParticleView<D>& P, const PhysicsPar
   const Real m_j = P.mass[j];
   const std::uint8_t mat_j = P.kind[j] == std::uint8_t(Kind::fluid) ? P.material[j] : std::uint8_t(prm.wall_material);
   const MaterialParams& Mj = prm.materials[mat_j];
-  // No-slip mDBC: a boundary particle shows the viscous terms the mirrored fluid velocity.
-  const bool mirrored = P.viscous_velocity != nullptr &&
-                        (P.kind[j] == std::uint8_t(Kind::wall) || P.kind[j] == std::uint8_t(Kind::structure));
-  const Vec<D> vij = vi - (mirrored ? P.viscous_velocity[j] : P.velocity[j]);
+  const Vec<D> vij = vi - viscous_velocity_of<D>(P, j);
   const Real eta2 = kEta2Factor * h * h;
   Real s = pair::pressure(m_j, p_i, P.pressure[j], rho_i, rho_j, F);
   if (prm.viscosity == Viscosity::artificial) {
@@ -456,7 +551,9 @@ TURBID_HD inline Vec<D> momentum_pair(const ParticleView<D>& P, const PhysicsPar
                                     Real(0.5) * (rho_i + rho_j), m_j, dot(vij, rij), r2, eta2, F);
     return s * rij;
   }
-  return s * rij + pair::laminar_viscosity(m_j, Mi.dynamic_viscosity, Mj.dynamic_viscosity, rho_i, rho_j, r2, eta2, F) * vij;
+  const bool fluid_j = P.kind[j] == std::uint8_t(Kind::fluid);
+  const Real mu_j = !fluid_j ? mu_i : (P.effective_viscosity ? P.effective_viscosity[j] : Mj.dynamic_viscosity);
+  return s * rij + pair::laminar_viscosity(m_j, mu_i, mu_j, rho_i, rho_j, r2, eta2, F) * vij;
 }
 
 // Momentum (pressure gradient, viscosity, gravity) for fluid particles; walls get zero.
@@ -480,6 +577,7 @@ struct MomentumPass {
     const Real p_i = P.pressure[i];
     const Real h_i = UniformH ? prm.smoothing_length : P.smoothing_length[i];
     const MaterialParams& Mi = prm.materials[P.material[i]];
+    const Real mu_i = P.effective_viscosity ? P.effective_viscosity[i] : Mi.dynamic_viscosity;
     const bool artificial = prm.viscosity == Viscosity::artificial;
 #if !defined(__CUDA_ARCH__)
     if constexpr (UniformH) {
@@ -501,15 +599,13 @@ struct MomentumPass {
       Real div_r = 0;
       Real grad_v[D][D] = {};
       for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
-        acc += momentum_pair<D, K, UniformH>(P, prm, vi, rho_i, p_i, h_i, Mi, j, rij, r2);
+        acc += momentum_pair<D, K, UniformH>(P, prm, vi, rho_i, p_i, h_i, Mi, mu_i, j, rij, r2);
         const Real h = pair_h<D, K>(P, prm, UniformH, h_i, j);
         if (!UniformH && r2 >= Real(4) * h * h) return;
         const Real FV = K::f_inv(std::sqrt(r2), Real(1) / h) * P.mass[j] / P.density[j];
         grad_c += FV * rij;
         div_r -= FV * r2;
-        const bool mirrored = P.viscous_velocity != nullptr && (P.kind[j] == std::uint8_t(Kind::wall) ||
-                                                                P.kind[j] == std::uint8_t(Kind::structure));
-        const Vec<D> vji = (mirrored ? P.viscous_velocity[j] : P.velocity[j]) - vi;
+        const Vec<D> vji = viscous_velocity_of<D>(P, j) - vi;
         for (int a = 0; a < D; ++a)
           for (int b = 0; b < D; ++b) grad_v[a][b] += vji[a] * FV * rij[b];
       });
@@ -519,7 +615,7 @@ struct MomentumPass {
         for (int b = 0; b < D; ++b) acc[a] += us[b] * grad_v[a][b];
     } else {
       for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
-        acc += momentum_pair<D, K, UniformH>(P, prm, vi, rho_i, p_i, h_i, Mi, j, rij, r2);
+        acc += momentum_pair<D, K, UniformH>(P, prm, vi, rho_i, p_i, h_i, Mi, mu_i, j, rij, r2);
       });
     }
     for (int k = 0; k < D; ++k) acc[k] += prm.gravity[k];

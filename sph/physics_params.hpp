@@ -5,6 +5,7 @@
 #include "sph/config.hpp"
 #include "sph/eos.hpp"
 #include "sph/kernels.hpp"
+#include "sph/rheology.hpp"
 
 namespace turbid::sph {
 
@@ -48,7 +49,9 @@ struct BufferZone {
 struct MaterialParams {
   TaitEos eos;
   Real sound_speed;        // c0 [m/s]
-  Real dynamic_viscosity;  // mu [Pa s]
+  Real dynamic_viscosity;  // mu [Pa s]; non-Newtonian: the largest mu_eff allowed (the cap)
+  Rheology rheology;       // mu_eff(shear rate); Newtonian: consistency = mu, no yield stress
+  bool non_newtonian = false;
 };
 
 struct PhysicsParams {
@@ -74,6 +77,14 @@ struct PhysicsParams {
   bool uniform_h = true;       // every particle has h == smoothing_length (fast path)
   Real max_smoothing_length = 0;  // largest h present [m]; the neighbour search covers 2 h_max
   Real gravity[3] = {0, 0, 0}; // [m/s^2]
+  // Periodic axes: period[a] > 0 is the domain's length along a; particles leaving through one
+  // face re-enter through the other at periodic_origin[a] + period[a].
+  bool periodic = false;
+  Real period[3] = {0, 0, 0};         // [m]
+  Real periodic_origin[3] = {0, 0, 0}; // [m]
+  // Some material is not Newtonian: a rheology pass computes each fluid particle's shear rate and
+  // effective viscosity before the momentum pass (fields shear_rate, effective_viscosity, shear_stress).
+  bool rheology = false;
   int material_count = 0;
   int wall_material = 0;       // EOS used for wall particles' pressure
   bool uniform_sound_speed = false;  // every material has the same c0 (pair loops skip the lookup)

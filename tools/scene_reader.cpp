@@ -404,7 +404,6 @@ Value MapView::need(std::string_view key) const {
 const std::vector<std::string> kTopKeys = {"name",   "dimensions", "resolution", "time",   "gravity",
                                            "numerics", "materials", "walls",     "structures", "fluids",
                                            "open_boundaries", "probes", "output", "domain"};
-const std::vector<std::string> kFutureMaterialModels = {"bingham", "herschel_bulkley"};
 
 fsi::Scene Reader::read(const std::string& yaml_text) {
   std::vector<YAML::Node> documents;
@@ -459,9 +458,19 @@ fsi::Scene Reader::read(const std::string& yaml_text) {
     if (auto v = top.get("numerics")) read_numerics(*v, scene.numerics);
     read_materials(top.need("materials"), scene);
     if (auto v = top.get("domain")) {
-      fsi::Box b = box(*v, dims);
+      MapView dm(*this, *v, {"min", "max", "periodic"});
+      fsi::Box b;
+      b.min = point(dm.need("min"), dims, "m");
+      b.max = point(dm.need("max"), dims, "m");
       require_ordered(*v, b, dims);
       scene.domain = b;
+      if (auto pv = dm.get("periodic")) {
+        // Particles leaving through one face of a periodic axis come back through the other.
+        for (const Value& a : list(*pv)) {
+          const std::size_t k = choice(a, std::vector<std::string>(kAxisName, kAxisName + dims));
+          scene.periodic[k] = true;
+        }
+      }
     }
     std::vector<YAML::Mark> wall_marks;
     if (auto v = top.get("walls")) read_walls(*v, scene, wall_marks);
@@ -532,27 +541,51 @@ void Reader::read_materials(const Value& v, fsi::Scene& scene) const {
     fail(v.mark, "'materials' must define at least one material, e.g. 'water: {density: 1000}'");
   for (const auto& e : all.entries()) {
     if (e.key.empty()) fail(e.key_mark, "a material needs a non-empty name");
-    MapView m(*this, all.entry_value(e, "material '" + e.key + "'"),
-              {"model", "density", "viscosity", "sound_speed", "gamma", "background_pressure"}, false);
+    const Value item = all.entry_value(e, "material '" + e.key + "'");
     fsi::MaterialSpec mat;
     mat.name = e.key;
     mat.where = where(e.key_mark);
-    // The model first: keys of a model not supported yet would otherwise be reported as unknown.
-    if (auto model = m.get("model")) {
-      const std::string name = text(*model);
-      if (std::find(kFutureMaterialModels.begin(), kFutureMaterialModels.end(), name) != kFutureMaterialModels.end())
-        fail(model->mark, "material model '" + name + "' is not supported yet; only 'newtonian' is available");
-      if (name != "newtonian") {
-        std::vector<std::string> known = kFutureMaterialModels;
-        known.insert(known.begin(), "newtonian");
-        fail(model->mark, "'model' must be 'newtonian' (the only model supported so far), got '" + name + "'" +
-                              did_you_mean(name, known));
-      }
-      mat.model = name;
+    // The model first: which keys are allowed depends on it.
+    std::size_t model = 0;
+    std::optional<Value> model_value;
+    if (item.node.IsMap()) {
+      MapView peek(*this, item, {}, false);
+      if ((model_value = peek.get("model")))
+        model = choice(*model_value, {"newtonian", "bingham", "herschel_bulkley"});
     }
-    m.check_keys();
+    mat.model = model == 0 ? "newtonian" : model == 1 ? "bingham" : "herschel_bulkley";
+    std::vector<std::string> keys = {"model", "density", "viscosity", "sound_speed", "gamma", "background_pressure"};
+    if (model == 1) keys.insert(keys.end(), {"yield_stress", "papanastasiou_exponent", "max_viscosity"});
+    if (model == 2) {
+      keys.erase(std::find(keys.begin(), keys.end(), "viscosity"));
+      keys.insert(keys.end(), {"yield_stress", "consistency", "flow_index", "papanastasiou_exponent", "max_viscosity"});
+    }
+    MapView m(*this, item, keys);
     mat.density = number(m.need("density"), positive(), "kg/m^3");
-    if (auto x = m.get("viscosity")) mat.viscosity = number(*x, non_negative(), "Pa s");
+    if (model == 1) {
+      mat.viscosity = number(m.need("viscosity"), non_negative(), "Pa s");  // plastic viscosity mu_B
+    } else if (auto x = m.get("viscosity")) {
+      mat.viscosity = number(*x, non_negative(), "Pa s");
+    }
+    if (model != 0) {
+      mat.yield_stress = number(m.need("yield_stress"), non_negative(), "Pa");
+      if (model == 2) {
+        mat.consistency = number(m.need("consistency"), non_negative(), "Pa s^n");
+        mat.flow_index = number(m.need("flow_index"), positive());
+        mat.viscosity = 0;
+      }
+      if (auto x = m.get("papanastasiou_exponent")) {
+        mat.papanastasiou_exponent = number(*x, positive(), "s");
+      } else if (mat.yield_stress > 0) {
+        fail(m.value().mark, "material '" + e.key + "' has a yield stress and needs 'papanastasiou_exponent' m [s] "
+                             "(the regularisation mu_eff = tau_y (1 - exp(-m gamma_dot)) / gamma_dot; m of 100-1000 s "
+                             "is typical)");
+      }
+      if (auto x = m.get("max_viscosity")) mat.max_viscosity = number(*x, positive(), "Pa s");
+      if (scene.numerics.viscosity != fsi::ViscosityKind::laminar)
+        fail(model_value->mark, "material model '" + mat.model + "' needs the laminar viscosity term: add "
+                                "'viscosity: {type: laminar}' under 'numerics'");
+    }
     if (auto x = m.get("sound_speed")) mat.sound_speed = number(*x, positive(), "m/s");
     if (auto x = m.get("gamma")) mat.gamma = number(*x, positive());
     if (auto x = m.get("background_pressure")) mat.background_pressure = number(*x, any_number(), "Pa");

@@ -37,17 +37,9 @@ class CpuBackend final : public Backend {
     ids_ = ids;
     params_ = params;
     omp_set_num_threads(threads_);
-    const int d = params.dimensions;
-    const double cell = 2.0 * params.smoothing_length * max_h_ratio();
-    cell_count_ = 1;
-    for (int k = 0; k < d; ++k) {
-      origin_[k] = domain.min[k];
-      domain_max_[k] = domain.max[k];
-      cells_[k] = std::max(1, int(std::ceil((domain.max[k] - domain.min[k]) / cell)));
-      cell_count_ *= std::size_t(cells_[k]);
-    }
-    if (cell_count_ > (std::size_t(1) << 31)) throw std::runtime_error("domain too large for the cell grid; give a smaller domain");
-    inv_cell_ = 1.0 / cell;
+    layout_ = GridLayout::make(domain, params.dimensions, 2.0 * params.smoothing_length * max_h_ratio());
+    cell_count_ = layout_.cell_count;
+    for (int k = 0; k < params.dimensions; ++k) domain_max_[k] = domain.max[k];
     cell_start_.assign(cell_count_ + 1, 0);
   }
 
@@ -144,6 +136,9 @@ class CpuBackend final : public Backend {
     if (ids_.zone >= 0) v.zone = s.data<std::uint8_t>(ids_.zone);
     if (ids_.viscous_velocity >= 0) v.viscous_velocity = s.data<Vec<D>>(ids_.viscous_velocity);
     if (ids_.shifting_velocity >= 0) v.shifting_velocity = s.data<Vec<D>>(ids_.shifting_velocity);
+    if (ids_.shear_rate >= 0) v.shear_rate = s.data<Real>(ids_.shear_rate);
+    if (ids_.effective_viscosity >= 0) v.effective_viscosity = s.data<Real>(ids_.effective_viscosity);
+    if (ids_.shear_stress >= 0) v.shear_stress = s.data<Real>(ids_.shear_stress);
     v.count = std::uint32_t(s.size());
     if (soa_valid_) {
       v.position_soa = soa_.data();
@@ -154,15 +149,7 @@ class CpuBackend final : public Backend {
 
   template <int D>
   GridView<D> grid() const {
-    GridView<D> g;
-    for (int k = 0; k < D; ++k) {
-      g.origin[k] = Real(origin_[k]);
-      g.cells[k] = cells_[k];
-    }
-    g.inv_cell = Real(inv_cell_);
-    g.cell_start = cell_start_.data();
-    g.fluid_before = fluid_before_.empty() ? nullptr : fluid_before_.data();
-    return g;
+    return layout_.view<D>(cell_start_.data(), fluid_before_.empty() ? nullptr : fluid_before_.data());
   }
 
   // The neighbour list recorded by the momentum pass, reused by the next continuity pass (same
@@ -274,6 +261,7 @@ class CpuBackend final : public Backend {
       if (params_.boundary == Boundary::mdbc)
         parallel_for(P.count, MdbcPass<D, K, U>{P, G, params_, params_.mdbc_no_slip});
       if (params_.zone_count > 0) parallel_for(P.count, BufferPass<D, K, U>{P, G, params_});
+      if (params_.rheology) parallel_for(P.count, RheologyPass<D, K, U>{P, G, params_});
       parallel_for(P.count, PressurePass<D>{P, params_});
       parallel_for(P.count, MomentumPass<D, K, U>{P, G, params_, list(true)});
       if (params_.body_count > 0) parallel_for(P.count, StructureForcePass<D, K, U>{P, G, params_});
@@ -289,7 +277,7 @@ class CpuBackend final : public Backend {
   template <int D>
   void drift_impl(Real dt) {
     parallel_for(std::uint32_t(store_->size()),
-                 DriftPass<D>{view<D>(), dt, params_.materials[params_.wall_material].eos.no_tension_density()});
+                 DriftPass<D>{view<D>(), dt, params_.materials[params_.wall_material].eos.no_tension_density(), params_});
   }
 
   template <int D>
@@ -353,9 +341,9 @@ class CpuBackend final : public Backend {
       int c[D] = {};
       G.cell_of(P.position[i], c);
       std::size_t local = 0;
-      G.for_each_neighbour_range(c, [&](std::uint32_t b, std::uint32_t e) {
+      G.for_each_neighbour_range(c, [&](std::uint32_t b, std::uint32_t e, const Vec<D>& offset) {
         for (std::uint32_t j = b; j < e; ++j)
-          if (j != std::uint32_t(i) && norm2(P.position[i] - P.position[j]) < Real(4) * h * h) ++local;
+          if (j != std::uint32_t(i) && norm2(P.position[i] - P.position[j] - offset) < Real(4) * h * h) ++local;
       });
       total += local;
     }
@@ -366,10 +354,8 @@ class CpuBackend final : public Backend {
   ParticleStore* store_ = nullptr;
   FieldIds ids_;
   PhysicsParams params_;
-  double origin_[3] = {0, 0, 0};
+  GridLayout layout_;
   double domain_max_[3] = {0, 0, 0};
-  int cells_[3] = {1, 1, 1};
-  double inv_cell_ = 1;
   std::size_t cell_count_ = 1;
   std::vector<std::uint32_t> cell_start_, cursor_, keys_, order_;
   std::vector<std::uint32_t> list_entries_, list_count_, fluid_before_;

@@ -168,9 +168,9 @@ struct PairCountPass {
     G.cell_of(P.position[i], c);
     unsigned long long local = 0;
     const Vec<D> xi = P.position[i];
-    G.for_each_neighbour_range(c, [&](std::uint32_t b, std::uint32_t e) {
+    G.for_each_neighbour_range(c, [&](std::uint32_t b, std::uint32_t e, const Vec<D>& offset) {
       for (std::uint32_t j = b; j < e; ++j)
-        if (j != i && norm2(xi - P.position[j]) < Real(4) * h * h) ++local;
+        if (j != i && norm2(xi - P.position[j] - offset) < Real(4) * h * h) ++local;
     });
     out[i] = local;
   }
@@ -198,17 +198,9 @@ class CudaBackend final : public Backend {
     store_ = &store;
     ids_ = ids;
     params_ = params;
-    const int d = params.dimensions;
-    const double cell = 2.0 * params.smoothing_length * max_h_ratio();
-    cell_count_ = 1;
-    for (int k = 0; k < d; ++k) {
-      origin_[k] = domain.min[k];
-      domain_max_[k] = domain.max[k];
-      cells_[k] = std::max(1, int(std::ceil((domain.max[k] - domain.min[k]) / cell)));
-      cell_count_ *= std::size_t(cells_[k]);
-    }
-    if (cell_count_ > (std::size_t(1) << 31)) throw std::runtime_error("domain too large for the cell grid; give a smaller domain");
-    inv_cell_ = 1.0 / cell;
+    layout_ = GridLayout::make(domain, params.dimensions, 2.0 * params.smoothing_length * max_h_ratio());
+    cell_count_ = layout_.cell_count;
+    for (int k = 0; k < params.dimensions; ++k) domain_max_[k] = domain.max[k];
     key_bits_ = 1;
     while (key_bits_ < 32 && (std::uint64_t(1) << key_bits_) <= cell_count_) ++key_bits_;
     cell_start_.allocate((cell_count_ + 1) * sizeof(std::uint32_t));
@@ -238,8 +230,8 @@ class CudaBackend final : public Backend {
 
   void drift(double dt) override {
     const Real wall_rho_min = params_.materials[params_.wall_material].eos.no_tension_density();
-    if (params_.dimensions == 2) launch("DriftPass<2>", n_, DriftPass<2>{view<2>(), Real(dt), wall_rho_min});
-    else launch("DriftPass<3>", n_, DriftPass<3>{view<3>(), Real(dt), wall_rho_min});
+    if (params_.dimensions == 2) launch("DriftPass<2>", n_, DriftPass<2>{view<2>(), Real(dt), wall_rho_min, params_});
+    else launch("DriftPass<3>", n_, DriftPass<3>{view<3>(), Real(dt), wall_rho_min, params_});
   }
 
   // Conversions at open boundaries run on the host (few particles change; the store is copied
@@ -367,20 +359,16 @@ class CudaBackend final : public Backend {
     if (ids_.zone >= 0) v.zone = static_cast<std::uint8_t*>(field(ids_.zone));
     if (ids_.viscous_velocity >= 0) v.viscous_velocity = static_cast<Vec<D>*>(field(ids_.viscous_velocity));
     if (ids_.shifting_velocity >= 0) v.shifting_velocity = static_cast<Vec<D>*>(field(ids_.shifting_velocity));
+    if (ids_.shear_rate >= 0) v.shear_rate = static_cast<Real*>(field(ids_.shear_rate));
+    if (ids_.effective_viscosity >= 0) v.effective_viscosity = static_cast<Real*>(field(ids_.effective_viscosity));
+    if (ids_.shear_stress >= 0) v.shear_stress = static_cast<Real*>(field(ids_.shear_stress));
     v.count = n_;
     return v;
   }
 
   template <int D>
   GridView<D> grid() const {
-    GridView<D> g;
-    for (int k = 0; k < D; ++k) {
-      g.origin[k] = Real(origin_[k]);
-      g.cells[k] = cells_[k];
-    }
-    g.inv_cell = Real(inv_cell_);
-    g.cell_start = cell_start_.as<std::uint32_t>();
-    return g;
+    return layout_.view<D>(cell_start_.as<std::uint32_t>(), nullptr);
   }
 
   // new[i] = old[order[i]] for one field, by its size in bytes per particle.
@@ -457,6 +445,7 @@ class CudaBackend final : public Backend {
       if (params_.boundary == Boundary::mdbc)
         launch("MdbcPass", P.count, MdbcPass<D, K, U>{P, G, params_, params_.mdbc_no_slip});
       if (params_.zone_count > 0) launch("BufferPass", P.count, BufferPass<D, K, U>{P, G, params_});
+      if (params_.rheology) launch("RheologyPass", P.count, RheologyPass<D, K, U>{P, G, params_});
       launch("PressurePass", P.count, PressurePass<D>{P, params_});
       launch("MomentumPass", P.count, MomentumPass<D, K, U>{P, G, params_, NeighbourList{}});
       if (params_.body_count > 0) launch("StructureForcePass", P.count, StructureForcePass<D, K, U>{P, G, params_});
@@ -524,10 +513,8 @@ class CudaBackend final : public Backend {
   ParticleStore* store_ = nullptr;
   FieldIds ids_;
   PhysicsParams params_;
-  double origin_[3] = {0, 0, 0};
+  GridLayout layout_;
   double domain_max_[3] = {0, 0, 0};
-  int cells_[3] = {1, 1, 1};
-  double inv_cell_ = 1;
   std::size_t cell_count_ = 1;
   int key_bits_ = 1;          // radix sort bits: enough for keys 0..cell_count
   std::uint32_t n_ = 0;       // particles on the device
