@@ -157,6 +157,7 @@ struct NumericsSpec {
   double density_ratio_limit = 0.5;        // |rho/rho0 - 1| above this stops the run [-]
   BoundaryKind boundary = BoundaryKind::dbc;  // wall treatment for walls and structures
   bool no_slip = false;                    // mDBC: boundary velocity mirrors the fluid's (no-slip walls)
+  bool interface_correction = true;        // ghost-density correction across material interfaces (paper eq. 3)
   double shifting_coefficient = 0;         // particle shifting A [-]; 0 = off
   double shifting_surface_threshold = -1;  // div r below this: free surface, not shifted; < 0: D - 0.5
 };

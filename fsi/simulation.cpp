@@ -22,15 +22,26 @@
 namespace turbid::fsi {
 namespace {
 
-double gravity_norm(const Scene& s) {
-  return std::sqrt(s.gravity[0] * s.gravity[0] + s.gravity[1] * s.gravity[1] + s.gravity[2] * s.gravity[2]);
+// The part of gravity that builds a hydrostatic pressure: along a periodic axis it is a uniform
+// body force that drives the flow (a channel), with no head to balance it.
+Vec3d hydrostatic_gravity(const Scene& s) {
+  Vec3d g = s.gravity;
+  for (std::size_t k = 0; k < 3; ++k)
+    if (s.periodic[k]) g[k] = 0;
+  return g;
 }
 
-// Height of a point against gravity [m] (0 without gravity).
+double gravity_norm(const Scene& s) {
+  const Vec3d g = hydrostatic_gravity(s);
+  return std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+}
+
+// Height of a point against (hydrostatic) gravity [m] (0 without gravity).
 double height_of(const Scene& s, const Vec3d& x) {
   const double g = gravity_norm(s);
   if (g == 0) return 0;
-  return -(x[0] * s.gravity[0] + x[1] * s.gravity[1] + x[2] * s.gravity[2]) / g;
+  const Vec3d gv = hydrostatic_gravity(s);
+  return -(x[0] * gv[0] + x[1] * gv[1] + x[2] * gv[2]) / g;
 }
 
 // Lowest and highest point of a box against gravity [m].
@@ -52,6 +63,38 @@ HeightRange box_heights(const Scene& s, const Box& b) {
 }
 
 geometry::Aabb to_aabb(const Box& b) { return {b.min, b.max}; }
+
+// Length of the ray x + t u (t >= 0) inside box b (first d axes; slab method) [m].
+double ray_length_in_box(const Vec3d& x, const Vec3d& u, const Box& b, int d) {
+  double t0 = 0, t1 = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < d; ++k) {
+    if (std::abs(u[k]) < 1e-12) {
+      if (x[k] < b.min[k] || x[k] > b.max[k]) return 0;
+      continue;
+    }
+    double ta = (b.min[k] - x[k]) / u[k], tb = (b.max[k] - x[k]) / u[k];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  return std::max(0.0, t1 - t0);
+}
+
+// Hydrostatic gauge pressure at x under fluid blocks of several densities (layers) [Pa]: the
+// weight of the fluid above x, sum over blocks of rho0 g times the length of the upward vertical
+// through x inside the block (physics.md D8: p = rho_w g H_w + rho_s g (z_i - z) in the lower layer).
+double layered_pressure(const Scene& s, const sph::PhysicsParams& p, const Vec3d& x,
+                        const std::vector<std::uint8_t>& block_material) {
+  const double g = gravity_norm(s);
+  if (g == 0) return 0;
+  const Vec3d gv = hydrostatic_gravity(s);
+  const Vec3d up{-gv[0] / g, -gv[1] / g, -gv[2] / g};
+  double pressure = 0;
+  for (std::size_t b = 0; b < s.fluids.size(); ++b)
+    pressure += double(p.materials[block_material[b]].eos.rest_density) * g *
+                ray_length_in_box(x, up, s.fluids[b].box, s.dimensions);
+  return pressure;
+}
 
 using geometry::Point;
 
@@ -312,6 +355,7 @@ sph::PhysicsParams physics_params(const Scene& scene) {
     }
   }
   p.wall_material = 0;
+  p.interface_correction = scene.numerics.interface_correction && p.material_count > 1;
   p.uniform_sound_speed = true;
   for (int m = 1; m < p.material_count; ++m)
     p.uniform_sound_speed = p.uniform_sound_speed && p.materials[m].sound_speed == p.materials[0].sound_speed;
@@ -323,6 +367,7 @@ sph::PhysicsParams physics_params(const Scene& scene) {
       p.periodic_origin[k] = sph::Real(scene.domain->min[std::size_t(k)]);
     }
   }
+  for (int k = 0; k < 3; ++k) p.hydrostatic_gravity[k] = p.period[k] > 0 ? sph::Real(0) : p.gravity[k];
   p.boundary = scene.numerics.boundary == BoundaryKind::mdbc ? sph::Boundary::mdbc : sph::Boundary::dbc;
   p.mdbc_no_slip = scene.numerics.no_slip;
   p.body_count = int(scene.structures.size());
@@ -441,6 +486,30 @@ void Simulation::build_particles() {
   }
   const StructureCarver carver(std::move(solids), dx);
 
+  // Fluid blocks of several densities (layers) start from the weight of all fluid above each
+  // particle; a single density keeps the depth below its block's top (same values, same bits).
+  std::vector<std::uint8_t> block_material;
+  for (const auto& f : s.fluids) block_material.push_back(material_of(f.material, f.where));
+  bool layered = false;
+  for (std::uint8_t bm : block_material)
+    layered = layered || params_.materials[bm].eos.rest_density != params_.materials[block_material[0]].eos.rest_density;
+  // Walls under layers: the column above the nearest point of the fluid blocks' footprint.
+  Box footprint{{1e300, 1e300, 1e300}, {-1e300, -1e300, -1e300}};
+  for (const auto& f : s.fluids)
+    for (int k = 0; k < 3; ++k) {
+      footprint.min[k] = std::min(footprint.min[k], f.box.min[k]);
+      footprint.max[k] = std::max(footprint.max[k], f.box.max[k]);
+    }
+  auto layered_density = [&](const sph::TaitEos& eos, const Vec3d& x, bool clamp_to_footprint) {
+    Vec3d xc = x;
+    if (clamp_to_footprint) {
+      const Vec3d gv = hydrostatic_gravity(s);
+      for (int k = 0; k < d; ++k)
+        if (gv[k] == 0) xc[k] = std::clamp(x[k], footprint.min[k], footprint.max[k]);
+    }
+    return eos.density_at_gauge(layered_pressure(s, params_, xc, block_material));
+  };
+
   for (const auto& f : s.fluids) {
     const std::uint8_t m = material_of(f.material, f.where);
     const auto& eos = params_.materials[m].eos;
@@ -467,7 +536,8 @@ void Simulation::build_particles() {
         continue;
       }
       const double depth = std::max(0.0, top - height_of(s, x));
-      items.push_back({x, eos.hydrostatic_density(g, depth), m, sph::Kind::fluid, {0, 0, 0}, sph::kNoBody, cell_volume,
+      const double rho = layered ? layered_density(eos, x, false) : eos.hydrostatic_density(g, depth);
+      items.push_back({x, rho, m, sph::Kind::fluid, {0, 0, 0}, sph::kNoBody, cell_volume,
                        profile_velocity(f.initial_velocity, f.box, x, d)});
       ++summary_.particles_per_material[m];
     }
@@ -486,7 +556,8 @@ void Simulation::build_particles() {
         Item& it = items[first + q];
         if (it.volume <= cell_volume) continue;
         for (int k = 0; k < d; ++k) it.x[k] = (kept[q][k] * cell_volume + moments[q][k]) / it.volume;
-        it.density = eos.hydrostatic_density(g, std::max(0.0, top - height_of(s, it.x)));
+        it.density = layered ? layered_density(eos, it.x, false)
+                             : eos.hydrostatic_density(g, std::max(0.0, top - height_of(s, it.x)));
       }
     }
   }
@@ -511,7 +582,8 @@ void Simulation::build_particles() {
         case WallSpec::Kind::solid_box: ghost = ghost_solid_box(w.box, x, d); break;
         case WallSpec::Kind::polyline: ghost = ghost_polyline(w, x); break;
       }
-      items.push_back({x, wall_eos.hydrostatic_density(g, depth), 0, sph::Kind::wall, ghost, sph::kNoBody, cell_volume});
+      const double rho = layered ? layered_density(wall_eos, x, true) : wall_eos.hydrostatic_density(g, depth);
+      items.push_back({x, rho, 0, sph::Kind::wall, ghost, sph::kNoBody, cell_volume});
     }
   }
   summary_.wall_particles = items.size() - summary_.fluid_particles;

@@ -32,6 +32,10 @@ struct TaitEos {
   // rho0 without background pressure; below rho0 with one, so that a wall under suction (behind a
   // cylinder in a channel) follows the fluid down to p = 0.
   TURBID_HD Real no_tension_density() const { return density(Real(0)); }
+  // Density at gauge pressure p >= 0 (above the background pressure) [kg/m^3], in double.
+  double density_at_gauge(double p) const {
+    return double(rest_density) * std::pow(1.0 + p / double(stiffness), 1.0 / double(gamma));
+  }
   // Density that balances the hydrostatic pressure rho0 g depth (depth >= 0 below the surface).
   double hydrostatic_density(double gravity, double depth) const {
     return double(rest_density) * std::pow(1.0 + double(rest_density) * gravity * depth / double(stiffness),

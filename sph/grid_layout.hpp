@@ -35,7 +35,9 @@ struct GridLayout {
       const double length = domain.max[k] - domain.min[k];
       g.origin[k] = domain.min[k];
       if (domain.periodic[k]) {
-        const int n = int(std::floor(length / cell));
+        // A whole number of supports is enough: 1e-5 absorbs the float rounding of h (a pair closer
+        // than 2h but farther than the cell then lies within 1e-5 of 2h, where the kernel vanishes).
+        const int n = int(std::floor(length / cell * (1 + 1e-5)));
         if (n < 3)
           throw std::runtime_error("a periodic axis must be at least 3 kernel supports long (" +
                                    std::to_string(3.0 * cell) + " m), got " + std::to_string(length) + " m");

@@ -29,6 +29,15 @@ TURBID_HD inline Real diffusion_antuono(Real delta_h_c0, Real rho_i, Real rho_j,
   return delta_h_c0 * F * vol_j * (Real(2) * (rho_i - rho_j) - dot(grad_i + grad_j, rij));
 }
 
+// The hydrostatic density difference rho^H = rho_j - rho_i expected between two points of one
+// material at rest, from g . r_ij: rho0 [(1 + x)^(1/gamma) - 1] with x = -rho0 g.r_ij / B, to second
+// order in x (|x| <= 2h gamma g / c0^2 < 1e-2 for c0 >= 10 sqrt(gH); error below 1e-6 rho0).
+// hydro_k = rho0 / B.
+TURBID_HD inline Real hydrostatic_difference(Real rho0, Real inv_gamma, Real hydro_k, Real g_dot_rij) {
+  const Real x = -hydro_k * g_dot_rij;
+  return rho0 * inv_gamma * x * (Real(1) + Real(0.5) * (inv_gamma - Real(1)) * x);
+}
+
 // Fourtakas et al. (2019) diffusion of the dynamic density only (C4): the hydrostatic density
 // difference rho^H_ij = rho0 [(1 + rho0 g (z_i - z_j) / B)^(1/gamma) - 1] is removed first.
 // Sign: diffusive when rho_j - rho_i exceeds the hydrostatic difference.

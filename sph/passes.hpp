@@ -368,16 +368,16 @@ struct ContinuityPass {
     const bool fluid_i = P.kind[i] == std::uint8_t(Kind::fluid);
     const std::uint8_t mat_i = fluid_i ? P.material[i] : std::uint8_t(prm.wall_material);
     const MaterialParams& Mi = prm.materials[mat_i];
-    // Fourtakas: rho^H_ij ~= rho0 [(1 + x)^(1/gamma) - 1], x = -rho0 g.r_ij / B, expanded to second
-    // order in x (|x| <= 2h gamma g / c0^2 < 1e-2 for c0 >= 10 sqrt(gH); error below 1e-6 rho0).
+    // Fourtakas: rho^H_ij (pair::hydrostatic_difference).
     const Real inv_gamma = Real(1) / Mi.eos.gamma;
     const Real hydro_k = Mi.eos.rest_density / Mi.eos.stiffness;
 
     Real drho = 0;
 #if !defined(__CUDA_ARCH__)
     if constexpr (UniformH && Diff != Diffusion::antuono) {
-      if (fluid_i && L.entries && !L.record && L.count[i] <= L.stride && L.count[i] <= kLaneNeighbours) {
-        P.density_rate[i] = lanes(i, xi, vi, rho_i, mat_i, Mi);
+      if (fluid_i && L.entries && !L.record && L.count[i] <= L.stride && L.count[i] <= kLaneNeighbours &&
+          lanes(i, xi, vi, rho_i, mat_i, Mi, drho)) {
+        P.density_rate[i] = drho;
         return;
       }
     }
@@ -407,17 +407,25 @@ struct ContinuityPass {
         const Real vol_j = P.mass[j] / rho_j;
         drho += pair::continuity(rho_i, vol_j, dot(vi - P.velocity[j], rij), F);
         if constexpr (Diff != Diffusion::none) {
-          if (fluid_i && fluid_j && P.material[j] == mat_i) {
+          Real rho_d = rho_j;  // the density of j the diffusion term sees
+          bool diffuse = fluid_i && fluid_j && P.material[j] == mat_i;
+          if (fluid_i && fluid_j && !diffuse && prm.interface_correction) {
+            rho_d = ghost_density(i, xi, rho_i, h, mat_i, rij);
+            diffuse = true;
+          }
+          if (diffuse) {
+            const Real rho_j = rho_d;
             if constexpr (Diff == Diffusion::molteni) {
               drho += pair::diffusion_molteni(prm.diffusion_delta * h * Mi.sound_speed, rho_i, rho_j, vol_j, F);
             } else if constexpr (Diff == Diffusion::antuono) {
+              // Across an interface the ghost stands for i's material: i's gradient at both ends.
+              const Vec<D>& grad_j = P.material[j] == mat_i ? P.density_gradient[j] : P.density_gradient[i];
               drho += pair::diffusion_antuono<D>(prm.diffusion_delta * h * Mi.sound_speed, rho_i, rho_j,
-                                                 P.density_gradient[i], P.density_gradient[j], rij, vol_j, F);
+                                                 P.density_gradient[i], grad_j, rij, vol_j, F);
             } else {
               Real gr = 0;
-              for (int k = 0; k < D; ++k) gr += prm.gravity[k] * rij[k];
-              const Real x = -hydro_k * gr;
-              const Real rho_h = Mi.eos.rest_density * inv_gamma * x * (Real(1) + Real(0.5) * (inv_gamma - Real(1)) * x);
+              for (int k = 0; k < D; ++k) gr += prm.hydrostatic_gravity[k] * rij[k];
+              const Real rho_h = pair::hydrostatic_difference(Mi.eos.rest_density, inv_gamma, hydro_k, gr);
               drho += pair::diffusion_fourtakas(prm.diffusion_delta * Real(2) * h * Mi.sound_speed, rho_i, rho_j, rho_h,
                                                 r2, kEta2Factor * h * h, vol_j, F);
             }
@@ -427,10 +435,47 @@ struct ContinuityPass {
     P.density_rate[i] = drho;
   }
 
-  // CPU, fluid particle with a recorded neighbour list: the same sums in lanes (see kLanes).
+  // The paper's interface correction (seed paper eq. 3, Fig. 1): for a neighbour j of another
+  // material, the density of j that i's diffusion term sees is the ghost density
+  //   rho_j* = sum_{j' in Phi_i} rho_j' W_jj' V_j' / sum_{j' in Phi_i} W_jj' V_j',
+  // a Shepard interpolation at x_j over the particles j' of i's own material in i's neighbourhood
+  // Phi_i (i included). x_j - x_j' = r_ij' - r_ij, so the walk is i's own neighbour walk again.
+  // With Fourtakas' diffusion each rho_j' is first carried to x_j along i's hydrostatic line
+  // (rho_j' + rho^H from x_j' to x_j): the j' lie on i's side of the interface, and their plain
+  // average would stand for a point higher than x_j, which the hydrostatic term of the diffusion
+  // would then read as a density defect at the interface.
+  TURBID_HD Real ghost_density(std::uint32_t i, const Vec<D>& xi, Real rho_i, Real h, std::uint8_t mat_i,
+                               const Vec<D>& rij) const {
+    const MaterialParams& Mi = prm.materials[mat_i];
+    const Real inv_gamma = Real(1) / Mi.eos.gamma;
+    const Real hydro_k = Mi.eos.rest_density / Mi.eos.stiffness;
+    // rho at x_j expected from rho_k at x_k, r = x_k - x_j
+    const auto carried = [&](Real rho_k, const Vec<D>& r) {
+      if constexpr (Diff != Diffusion::fourtakas) return rho_k;
+      Real gr = 0;
+      for (int a = 0; a < D; ++a) gr += prm.hydrostatic_gravity[a] * r[a];
+      return rho_k + pair::hydrostatic_difference(Mi.eos.rest_density, inv_gamma, hydro_k, gr);
+    };
+    const Real w_i = K::w(std::sqrt(norm2(rij)), h) * P.mass[i] / rho_i;  // j' = i: x_i - x_j = r_ij
+    Real num = w_i * carried(rho_i, rij), den = w_i;
+    for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t k, const Vec<D>& rik, Real) {
+      if (P.kind[k] != std::uint8_t(Kind::fluid) || P.material[k] != mat_i) return;
+      const Vec<D> rkj = rij - rik;  // x_k - x_j
+      const Real r = std::sqrt(norm2(rkj));
+      if (r >= Real(2) * h) return;
+      const Real w = K::w(r, h) * P.mass[k] / P.density[k];
+      num += w * carried(P.density[k], rkj);
+      den += w;
+    });
+    return den > Real(0) ? num / den : rho_i;
+  }
+
+  // CPU, fluid particle with a recorded neighbour list: the same sums in lanes (see kLanes). False
+  // (nothing done) when the interface correction needs the generic path (a neighbour of another
+  // material).
   static constexpr int W = kLanes;
-  Real lanes(std::uint32_t i, const Vec<D>& xi, const Vec<D>& vi, Real rho_i, std::uint8_t mat_i,
-             const MaterialParams& Mi) const {
+  bool lanes(std::uint32_t i, const Vec<D>& xi, const Vec<D>& vi, Real rho_i, std::uint8_t mat_i,
+             const MaterialParams& Mi, Real& result) const {
     const std::uint32_t* nb = L.entries + std::size_t(i) * L.stride;
     const std::uint32_t m = L.count[i];
     const std::uint32_t padded = (m + W - 1) / W * W;
@@ -443,7 +488,9 @@ struct ContinuityPass {
       g.set(k, P, prm, xi, vi, j, valid, h);
       rho_j[k] = P.density[j];
       vol_j[k] = (valid ? P.mass[j] : Real(0)) / P.density[j];
-      const bool s_mat = P.kind[j] == std::uint8_t(Kind::fluid) && P.material[j] == mat_i;
+      const bool fluid_j = P.kind[j] == std::uint8_t(Kind::fluid);
+      const bool s_mat = fluid_j && P.material[j] == mat_i;
+      if (fluid_j && !s_mat && prm.interface_correction && Diff != Diffusion::none) return false;
       same[k] = s_mat ? Real(1) : Real(0);
     }
     const Real inv_h = Real(1) / h;
@@ -457,14 +504,13 @@ struct ContinuityPass {
         const std::uint32_t k = k0 + std::uint32_t(l);
         const Real r2 = g.r2(k);
         Real gr = 0;
-        for (int a = 0; a < D; ++a) gr += prm.gravity[a] * g.r[a][k];
+        for (int a = 0; a < D; ++a) gr += prm.hydrostatic_gravity[a] * g.r[a][k];
         const Real F = K::f_inv(std::sqrt(r2), inv_h);
         Real d = pair::continuity(rho_i, vol_j[k], g.vr[k], F);
         if constexpr (Diff == Diffusion::molteni) {
           d += same[k] * pair::diffusion_molteni(dh, rho_i, rho_j[k], vol_j[k], F);
         } else if constexpr (Diff == Diffusion::fourtakas) {
-          const Real x = -hydro_k * gr;
-          const Real rho_h = Mi.eos.rest_density * inv_gamma * x * (Real(1) + Real(0.5) * (inv_gamma - Real(1)) * x);
+          const Real rho_h = pair::hydrostatic_difference(Mi.eos.rest_density, inv_gamma, hydro_k, gr);
           d += same[k] * pair::diffusion_fourtakas(Real(2) * dh, rho_i, rho_j[k], rho_h, r2, eta2, vol_j[k], F);
         }
         sum[l] += d;
@@ -472,7 +518,8 @@ struct ContinuityPass {
     }
     Real t = 0;
     for (int l = 0; l < W; ++l) t += sum[l];
-    return t;
+    result = t;
+    return true;
   }
 };
 

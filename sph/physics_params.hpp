@@ -77,6 +77,9 @@ struct PhysicsParams {
   bool uniform_h = true;       // every particle has h == smoothing_length (fast path)
   Real max_smoothing_length = 0;  // largest h present [m]; the neighbour search covers 2 h_max
   Real gravity[3] = {0, 0, 0}; // [m/s^2]
+  // Gravity less its components along periodic axes (a uniform driving force there, no head):
+  // the hydrostatic density difference of Fourtakas' diffusion uses this [m/s^2].
+  Real hydrostatic_gravity[3] = {0, 0, 0};
   // Periodic axes: period[a] > 0 is the domain's length along a; particles leaving through one
   // face re-enter through the other at periodic_origin[a] + period[a].
   bool periodic = false;
@@ -85,6 +88,9 @@ struct PhysicsParams {
   // Some material is not Newtonian: a rheology pass computes each fluid particle's shear rate and
   // effective viscosity before the momentum pass (fields shear_rate, effective_viscosity, shear_stress).
   bool rheology = false;
+  // The paper's ghost-density correction of density diffusion between fluids of different
+  // materials (seed paper eq. 3); off: no diffusion across an interface.
+  bool interface_correction = false;
   int material_count = 0;
   int wall_material = 0;       // EOS used for wall particles' pressure
   bool uniform_sound_speed = false;  // every material has the same c0 (pair loops skip the lookup)

@@ -43,6 +43,26 @@ double fluid_mass(const fsi::Simulation& sim) {
   return total;
 }
 
+// Mass and particle count of each material's fluid particles (scene order).
+struct MaterialTotals {
+  std::vector<double> mass;
+  std::vector<std::size_t> particles;
+};
+MaterialTotals material_totals(const fsi::Simulation& sim) {
+  const auto& s = sim.store();
+  const auto* m = s.data<float>(sim.fields().mass);
+  const auto* kind = s.data<std::uint8_t>(sim.fields().kind);
+  const auto* mat = s.data<std::uint8_t>(sim.fields().material);
+  const std::size_t n = sim.scene().materials.size();
+  MaterialTotals t{std::vector<double>(n, 0.0), std::vector<std::size_t>(n, 0)};
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (kind[i] == 0 && mat[i] < n) {
+      t.mass[mat[i]] += m[i];
+      ++t.particles[mat[i]];
+    }
+  return t;
+}
+
 class Writers final : public fsi::Observer {
  public:
   Writers(const fs::path& out, const fsi::Scene& scene, std::optional<double> resume_time, bool progress)
@@ -185,13 +205,28 @@ std::string describe_scene(const fsi::Scene& scene) {
     os << "  fluid lattice points left out inside structures: " << s.fluid_removed_by_structures
        << " (the part of their cells outside the structures, " << s.fluid_volume_restored << (two_d ? " m^2" : " m^3")
        << ", goes to the nearest fluid particles)\n";
-  for (std::size_t m = 0; m < scene.materials.size(); ++m)
-    os << "  material " << scene.materials[m].name << ": " << s.particles_per_material[m]
-       << " particles, sound speed " << s.sound_speed[m] << " m/s\n";
+  const sph::PhysicsParams params = fsi::physics_params(scene);
+  for (std::size_t m = 0; m < scene.materials.size(); ++m) {
+    const auto& mat = scene.materials[m];
+    os << "  material " << mat.name << ": " << s.particles_per_material[m] << " particles, sound speed "
+       << s.sound_speed[m] << " m/s, " << mat.model;
+    if (mat.model == "newtonian") {
+      os << ", viscosity " << mat.viscosity << " Pa s\n";
+      continue;
+    }
+    os << " (yield stress " << mat.yield_stress << " Pa, "
+       << (mat.model == "bingham" ? "plastic viscosity " + std::to_string(mat.viscosity) + " Pa s"
+                                  : "K " + std::to_string(mat.consistency) + " Pa s^n, n " + std::to_string(mat.flow_index))
+       << ", m " << mat.papanastasiou_exponent << " s), effective viscosity capped at "
+       << params.materials[m].rheology.max_viscosity << " Pa s" << (mat.max_viscosity > 0 ? "" : " (automatic)") << "\n";
+  }
   os << "domain           [" << s.domain.min[0] << ", " << s.domain.max[0] << "] x [" << s.domain.min[1] << ", "
      << s.domain.max[1] << "]";
   if (scene.dimensions == 3) os << " x [" << s.domain.min[2] << ", " << s.domain.max[2] << "]";
-  os << " m\n";
+  os << " m";
+  for (int k = 0; k < scene.dimensions; ++k)
+    if (s.domain.periodic[k]) os << ", periodic along " << "xyz"[k];
+  os << "\n";
   const double mib = double(total) * double(s.bytes_per_particle) / (1024.0 * 1024.0);
   os << "memory           " << s.bytes_per_particle << " bytes/particle, about " << mib << " MiB\n";
   os << "end time         " << scene.end_time << " s, output every " << scene.output.every << " s\n";
@@ -233,6 +268,7 @@ nlohmann::json run_scene(const RunRequest& request) {
   fsi::Simulation sim(scene, opts);
   const std::size_t initial_particles = sim.store().size();
   const double mass_start = fluid_mass(sim);
+  const MaterialTotals materials_start = material_totals(sim);
   Writers writers(out, sim.scene(), resume_time, request.progress);
   if (request.progress) {
     std::string gpu;
@@ -267,6 +303,8 @@ nlohmann::json run_scene(const RunRequest& request) {
   report["version"] = TURBID_VERSION;
   report["units"] = {{"simulated_time", "s"}, {"wall_seconds", "s"}, {"particle_steps_per_second", "1/s"},
                      {"fluid_mass", scene.dimensions == 2 ? "kg/m" : "kg"},
+                     {"mass_start", scene.dimensions == 2 ? "kg/m" : "kg"},
+                     {"mass_end", scene.dimensions == 2 ? "kg/m" : "kg"},
                      {"surface_area", scene.dimensions == 2 ? "m" : "m^2"},
                      {"volume", scene.dimensions == 2 ? "m^2" : "m^3"}};
   std::string status = "completed";
@@ -304,6 +342,14 @@ nlohmann::json run_scene(const RunRequest& request) {
   report["fluid_mass_start"] = mass_start;
   report["fluid_mass_end"] = mass_end;
   report["fluid_mass_relative_change"] = (mass_end - mass_start) / mass_start;
+  const MaterialTotals materials_end = material_totals(sim);
+  nlohmann::json per_material = nlohmann::json::array();
+  for (std::size_t m = 0; m < scene.materials.size(); ++m)
+    per_material.push_back({{"name", scene.materials[m].name}, {"model", scene.materials[m].model},
+                            {"particles_start", materials_start.particles[m]},
+                            {"particles_end", materials_end.particles[m]}, {"mass_start", materials_start.mass[m]},
+                            {"mass_end", materials_end.mass[m]}});
+  report["materials"] = per_material;
   write_run_json(out / "run.json", report);
   return report;
 }

@@ -488,7 +488,10 @@ fsi::Scene Reader::read(const std::string& yaml_text) {
 
 void Reader::read_numerics(const Value& v, fsi::NumericsSpec& n) const {
   MapView m(*this, v, {"kernel", "density_diffusion", "viscosity", "boundary", "shifting", "min_time_step",
-                                "max_density_variation"});
+                                "max_density_variation", "interface_correction"});
+  // Density diffusion between materials: the seed paper's ghost density (eq. 3), or none.
+  if (auto ic = m.get("interface_correction"))
+    n.interface_correction = choice(*ic, {"ghost_density", "none"}) == 0;
   if (auto bv = m.get("boundary")) {
     MapView b(*this, *bv, {"type", "velocity"});
     n.boundary = choice(b.need("type"), {"dbc", "mdbc"}) == 0 ? fsi::BoundaryKind::dbc : fsi::BoundaryKind::mdbc;

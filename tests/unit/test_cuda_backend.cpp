@@ -85,6 +85,7 @@ PhysicsParams make_params(const Case& c) {
   p.uniform_h = true;
   p.max_smoothing_length = p.smoothing_length;
   p.gravity[c.dimensions - 1] = Real(-9.81);
+  p.hydrostatic_gravity[c.dimensions - 1] = Real(-9.81);
   p.material_count = 1;
   p.wall_material = 0;
   p.materials[0].eos = TaitEos::make(kRho0, 20.0, 7.0, 0.0);
