@@ -13,7 +13,7 @@ namespace turbid::sph {
 
 // Bit k of the result is set iff r2[k] < limit, for k < len <= 64. With AVX, eight comparisons
 // per instruction; the plain loop gives the same bits elsewhere.
-inline std::uint64_t below_mask(const Real* r2, std::uint32_t len, Real limit) {
+TURBID_INLINE std::uint64_t below_mask(const Real* r2, std::uint32_t len, Real limit) {
   std::uint64_t mask = 0;
   std::uint32_t k = 0;
 #if defined(__AVX__) && !defined(__CUDA_ARCH__)

@@ -63,6 +63,7 @@ struct GridLayout {
       v.inv_cell[k] = Real(inv_cell[k]);
       v.cells[k] = cells[k];
       v.period[k] = Real(period[k]);
+      v.periodic = v.periodic || period[k] > 0;
     }
     v.cell_start = cell_start;
     v.fluid_before = fluid_before;

@@ -21,6 +21,7 @@ struct GridView {
   Real inv_cell[D];   // 1 / cell size per axis [1/m]
   int cells[D];       // number of cells per axis
   Real period[D];     // length of a periodic axis [m]; 0: not periodic
+  bool periodic = false;  // some axis is periodic
   const std::uint32_t* cell_start;  // size cell_count + 1: particles of cell c are [start[c], start[c+1])
   // Optional (CPU): fluid particles in cells [0, c) for each c (size cell_count + 1), so that a wall
   // particle can see at once that no fluid is near it.
@@ -62,7 +63,7 @@ struct GridView {
   // Calls f(begin, end, offset) for every contiguous range of particles in the cells around cell
   // c; offset is the image shift of those particles (zero unless the range wraps a periodic axis).
   template <class F>
-  TURBID_HD void for_each_neighbour_range(const int* c, F&& f) const {
+  TURBID_HD TURBID_INLINE void for_each_neighbour_range(const int* c, F&& f) const {
     for_each_cell_range(c, [&](std::uint32_t c0, std::uint32_t c1, const Vec<D>& offset) {
       f(cell_start[c0], cell_start[c1], offset);
     });
@@ -70,8 +71,31 @@ struct GridView {
   // Calls f(first cell, last cell + 1, offset) for every run of cells in the rows of 3 cells
   // around cell c (x fastest); a row that wraps a periodic x axis gives two runs.
   template <class F>
-  TURBID_HD void for_each_cell_range(const int* c, F&& f) const {
+  TURBID_HD TURBID_INLINE void for_each_cell_range(const int* c, F&& f) const {
     Vec<D> offset = Vec<D>::zero();
+    if (!periodic) {
+      // The common case: rows clipped at the grid's faces, no image offsets.
+      const int x0 = c[0] > 0 ? c[0] - 1 : 0;
+      const int x1 = c[0] + 1 < cells[0] ? c[0] + 1 : cells[0] - 1;
+      if constexpr (D == 2) {
+        for (int y = c[1] - 1; y <= c[1] + 1; ++y) {
+          if (y < 0 || y >= cells[1]) continue;
+          const std::uint32_t row = std::uint32_t(y) * std::uint32_t(cells[0]);
+          f(row + std::uint32_t(x0), row + std::uint32_t(x1) + 1, offset);
+        }
+      } else {
+        for (int z = c[2] - 1; z <= c[2] + 1; ++z) {
+          if (z < 0 || z >= cells[2]) continue;
+          for (int y = c[1] - 1; y <= c[1] + 1; ++y) {
+            if (y < 0 || y >= cells[1]) continue;
+            const std::uint32_t row =
+                (std::uint32_t(z) * std::uint32_t(cells[1]) + std::uint32_t(y)) * std::uint32_t(cells[0]);
+            f(row + std::uint32_t(x0), row + std::uint32_t(x1) + 1, offset);
+          }
+        }
+      }
+      return;
+    }
     if constexpr (D == 2) {
       for (int y = c[1] - 1; y <= c[1] + 1; ++y) {
         int yy = y;
@@ -95,7 +119,7 @@ struct GridView {
  private:
   // Maps a neighbour cell coordinate onto the grid: false if it is off a non-periodic axis; on a
   // periodic one it wraps, and `offset` gets the image shift of its particles.
-  TURBID_HD bool wrap(int axis, int& k, Real& offset) const {
+  TURBID_HD TURBID_INLINE bool wrap(int axis, int& k, Real& offset) const {
     offset = Real(0);
     if (k >= 0 && k < cells[axis]) return true;
     if (period[axis] == Real(0)) return false;
@@ -109,7 +133,7 @@ struct GridView {
     return true;
   }
   template <class F>
-  TURBID_HD void row_runs(int cx, std::uint32_t row, Vec<D> offset, F& f) const {
+  TURBID_HD TURBID_INLINE void row_runs(int cx, std::uint32_t row, Vec<D> offset, F& f) const {
     const int n = cells[0];
     if (period[0] == Real(0) || (cx > 0 && cx + 1 < n)) {
       const int x0 = cx > 0 ? cx - 1 : 0;

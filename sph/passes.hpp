@@ -54,7 +54,7 @@ inline constexpr Real kEta2Factor = Real(0.01);
 // The pair vector to the nearest periodic image, for vectors not taken from a grid range (which
 // carries its image offset): neighbour lists, ghost nodes. Unchanged without periodic axes.
 template <int D>
-TURBID_HD inline Vec<D> nearest_image(const PhysicsParams& prm, Vec<D> r) {
+TURBID_HD TURBID_INLINE Vec<D> nearest_image(const PhysicsParams& prm, Vec<D> r) {
   if (!prm.periodic) return r;
   for (int a = 0; a < D; ++a) {
     const Real L = prm.period[a];
@@ -85,7 +85,7 @@ struct NeighbourList {
 
 // Calls f(j, r_ij, r_ij^2) for every j != i with r_ij < 2 h_max, in grid order.
 template <int D, class F>
-TURBID_HD inline void for_each_neighbour(const ParticleView<D>& P, const GridView<D>& G, const NeighbourList& L,
+TURBID_HD TURBID_INLINE void for_each_neighbour(const ParticleView<D>& P, const GridView<D>& G, const NeighbourList& L,
                                          const PhysicsParams& prm, std::uint32_t i, const Vec<D>& xi, F&& f) {
   const Real support2 = Real(4) * prm.max_smoothing_length * prm.max_smoothing_length;
   if (L.entries && !L.record && L.count[i] <= L.stride) {
@@ -320,8 +320,8 @@ struct LaneGeometry {
   alignas(32) Real r[D][kLaneNeighbours + kLanes];
   alignas(32) Real vr[kLaneNeighbours + kLanes];
 
-  void set(std::uint32_t k, const ParticleView<D>& P, const PhysicsParams& prm, const Vec<D>& xi, const Vec<D>& vi,
-           std::uint32_t j, bool valid, Real h) {
+  TURBID_INLINE void set(std::uint32_t k, const ParticleView<D>& P, const PhysicsParams& prm, const Vec<D>& xi,
+                         const Vec<D>& vi, std::uint32_t j, bool valid, Real h) {
     const Vec<D> rij = nearest_image<D>(prm, xi - P.position[j]);
     Real dot_v = 0;
     for (int a = 0; a < D; ++a) {
