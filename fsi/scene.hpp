@@ -60,7 +60,8 @@ struct VelocityProfile {
 
 struct FluidBlock {
   std::string material;
-  Box box;
+  Box box;                       // the region; for a polygon its bounding box
+  std::vector<Vec3d> polygon;    // 2D: the region is this polygon (>= 3 vertices) instead of `box`
   VelocityProfile initial_velocity;  // across this block's box; none: at rest
   SourceLocation where;
 };

@@ -80,6 +80,29 @@ double ray_length_in_box(const Vec3d& x, const Vec3d& u, const Box& b, int d) {
   return std::max(0.0, t1 - t0);
 }
 
+// Point strictly inside a 2D polygon (crossing number).
+bool inside_polygon(const std::vector<Vec3d>& poly, double x, double y) {
+  bool in = false;
+  for (std::size_t a = 0, b = poly.size() - 1; a < poly.size(); b = a++) {
+    const double ya = poly[a][1], yb = poly[b][1];
+    if ((ya > y) != (yb > y) && x < (poly[b][0] - poly[a][0]) * (y - ya) / (yb - ya) + poly[a][0]) in = !in;
+  }
+  return in;
+}
+
+// The fluid block a point belongs to: the first whose region holds it (blocks listed earlier win
+// where regions overlap, so a slide can be cut out of the water around it); -1 for none.
+int block_of(const Scene& s, const Vec3d& x) {
+  for (std::size_t b = 0; b < s.fluids.size(); ++b) {
+    const FluidBlock& f = s.fluids[b];
+    bool in = true;
+    for (int k = 0; k < s.dimensions; ++k) in = in && x[k] >= f.box.min[k] && x[k] <= f.box.max[k];
+    if (in && !f.polygon.empty()) in = inside_polygon(f.polygon, x[0], x[1]);
+    if (in) return int(b);
+  }
+  return -1;
+}
+
 // Hydrostatic gauge pressure at x under fluid blocks of several densities (layers) [Pa]: the
 // weight of the fluid above x, sum over blocks of rho0 g times the length of the upward vertical
 // through x inside the block (physics.md D8: p = rho_w g H_w + rho_s g (z_i - z) in the lower layer).
@@ -89,10 +112,29 @@ double layered_pressure(const Scene& s, const sph::PhysicsParams& p, const Vec3d
   if (g == 0) return 0;
   const Vec3d gv = hydrostatic_gravity(s);
   const Vec3d up{-gv[0] / g, -gv[1] / g, -gv[2] / g};
+  bool polygons = false;
+  for (const auto& f : s.fluids) polygons = polygons || !f.polygon.empty();
   double pressure = 0;
-  for (std::size_t b = 0; b < s.fluids.size(); ++b)
-    pressure += double(p.materials[block_material[b]].eos.rest_density) * g *
-                ray_length_in_box(x, up, s.fluids[b].box, s.dimensions);
+  if (!polygons) {
+    for (std::size_t b = 0; b < s.fluids.size(); ++b)
+      pressure += double(p.materials[block_material[b]].eos.rest_density) * g *
+                  ray_length_in_box(x, up, s.fluids[b].box, s.dimensions);
+    return pressure;
+  }
+  // Polygons (which may overlap boxes, earlier blocks winning): midpoint rule along the vertical in
+  // steps of dx/8 up to the top of all blocks.
+  double top = -1e300;
+  for (const auto& f : s.fluids)
+    for (int c = 0; c < 4; ++c) {
+      const Vec3d corner{(c & 1) ? f.box.max[0] : f.box.min[0], (c & 2) ? f.box.max[1] : f.box.min[1], 0.0};
+      top = std::max(top, corner[0] * up[0] + corner[1] * up[1]);
+    }
+  const double length = top - (x[0] * up[0] + x[1] * up[1]);
+  const double step = s.particle_spacing / 8;
+  for (double t = 0.5 * step; t < length; t += step) {
+    const int b = block_of(s, {x[0] + t * up[0], x[1] + t * up[1], 0.0});
+    if (b >= 0) pressure += double(p.materials[block_material[std::size_t(b)]].eos.rest_density) * g * step;
+  }
   return pressure;
 }
 
@@ -529,7 +571,22 @@ void Simulation::build_particles() {
     }
     const std::size_t first = items.size();
     std::vector<Point> carved;
-    for (const auto& x : geometry::fill_box(to_aabb(f.box), dx, d)) {
+    const int this_block = int(&f - s.fluids.data());
+    // A polygon takes the points of the lattice anchored at the origin that fall inside it, so
+    // that polygons next to each other (a slide in the water around it) share one lattice.
+    std::vector<Point> lattice;
+    if (f.polygon.empty()) {
+      lattice = geometry::fill_box(to_aabb(f.box), dx, d);
+    } else {
+      // (i + 1/2) dx, computed from the integer indices so that a box anchored at the origin
+      // produces the very same coordinates.
+      const long i0 = long(std::floor(f.box.min[0] / dx + 1e-9)), i1 = long(std::ceil(f.box.max[0] / dx - 1e-9));
+      const long j0 = long(std::floor(f.box.min[1] / dx + 1e-9)), j1 = long(std::ceil(f.box.max[1] / dx - 1e-9));
+      for (long j = j0; j < j1; ++j)
+        for (long i = i0; i < i1; ++i) lattice.push_back({(double(i) + 0.5) * dx, (double(j) + 0.5) * dx, 0.0});
+    }
+    for (const auto& x : lattice) {
+      if (block_of(s, x) != this_block) continue;  // outside its polygon, or an earlier block's
       if (carver.blocks(x)) {
         ++summary_.fluid_removed_by_structures;
         carved.push_back(x);

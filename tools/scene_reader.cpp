@@ -669,7 +669,7 @@ void Reader::read_fluids(const Value& v, fsi::Scene& scene, const std::vector<YA
   const std::vector<Value> items = list(v);
   if (items.empty()) fail(v.mark, "'fluids' must list at least one fluid block");
   for (const Value& item : items) {
-    MapView m(*this, item, {"material", "box", "initial_velocity"});
+    MapView m(*this, item, {"material", "box", "polygon", "initial_velocity"});
     fsi::FluidBlock block;
     block.where = where(item.mark);
     const Value mv = m.need("material");
@@ -678,8 +678,26 @@ void Reader::read_fluids(const Value& v, fsi::Scene& scene, const std::vector<YA
       fail(mv.mark, "unknown material '" + block.material + "' in " + item.name +
                         did_you_mean(block.material, material_names) + " (defined materials: " +
                         join(material_names) + ")");
-    const Value bv = m.need("box");
-    block.box = box(bv, dims);
+    if (m.has("box") && m.has("polygon"))
+      fail(m.key_mark("polygon"), "a fluid block has both 'box' and 'polygon'; give one shape");
+    if (auto pv = m.get("polygon")) {
+      // 2D: a region bounded by a polygon (for example a slide on a slope); checked below as its
+      // bounding box.
+      if (dims != 2) fail(pv->mark, "'polygon' fluid blocks are 2D only; in 3D use a 'box'");
+      const std::vector<Value> pts = list(*pv);
+      if (pts.size() < 3) fail(pv->mark, "a fluid 'polygon' needs at least 3 points, got " + std::to_string(pts.size()));
+      fsi::Box bb{{1e300, 1e300, 0}, {-1e300, -1e300, 0}};
+      for (const Value& q : pts) {
+        block.polygon.push_back(point(q, dims, "m"));
+        for (int k = 0; k < 2; ++k) {
+          bb.min[k] = std::min(bb.min[k], block.polygon.back()[k]);
+          bb.max[k] = std::max(bb.max[k], block.polygon.back()[k]);
+        }
+      }
+      block.box = bb;
+    }
+    const Value bv = block.polygon.empty() ? m.need("box") : *m.get("polygon");
+    if (block.polygon.empty()) block.box = box(bv, dims);
     const fsi::Box& b = block.box;
     for (int k = 0; k < dims; ++k) {
       if (b.min[k] > b.max[k]) require_ordered(bv, b, dims);

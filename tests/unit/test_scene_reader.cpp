@@ -96,6 +96,8 @@ const BadScene kBadScenes[] = {
      "a key of another model (Herschel-Bulkley takes 'consistency')"},
     {"bingham_artificial.yaml", 7, 16, "needs the laminar viscosity term",
      "a non-Newtonian material with the artificial viscosity, located at its model"},
+    {"polygon_two_points.yaml", 9, 32, "a fluid 'polygon' needs at least 3 points, got 2", "a degenerate polygon"},
+    {"polygon_3d.yaml", 9, 32, "'polygon' fluid blocks are 2D only", "a polygon fluid block in 3D"},
     {"periodic_axis.yaml", 8, 50, "item 2 of 'periodic' must be 'x' or 'y', got 'z'", "a periodic z axis in 2D"},
     {"ratio_range.yaml", 4, 55, "'smoothing_ratio' must be a number in (0.5, 3], got 3.5",
      "a ratio outside its interval"},
