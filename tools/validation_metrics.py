@@ -283,7 +283,30 @@ def buoyancy_error(run_dir, volumes=None, column="Fy [N/m]", t_from=1.0, t_to=No
 BUOYANCY_3D_VOLUMES = {"cube": 0.15 ** 3, "cylinder": math.pi * 0.075 ** 2 * 0.3}
 
 
+def lock_exchange_speed(run_dir, contrast, x_from=0.5, x_to=1.1, depth=0.2):
+    """Front speed U / sqrt(g' H) of a lock-exchange run: least-squares slope of the probe 'front'
+    while it is between x_from and x_to (the constant-speed phase), g' = g * contrast."""
+    rows = read_csv(os.path.join(run_dir, "probes.csv"))
+    pts = [(t, x) for t, x in zip(rows["time"], rows["front"]) if x_from <= x <= x_to]
+    if len(pts) < 3:
+        raise SystemExit(f"{run_dir}: the front never crosses {x_from}-{x_to} m")
+    mt = sum(t for t, _ in pts) / len(pts)
+    mx = sum(x for _, x in pts) / len(pts)
+    slope = sum((t - mt) * (x - mx) for t, x in pts) / sum((t - mt) ** 2 for t, _ in pts)
+    return slope / math.sqrt(9.81 * contrast * depth)
+
+
 METRICS = {
+    "lock_exchange_5pct_2d": {
+        "description": "front speed U / sqrt(g' H) (theory 0.5, goal 0.43-0.52), 5% denser lock",
+        "error": lambda d: lock_exchange_speed(d, 0.05),
+        "extra": {},
+    },
+    "lock_exchange_10pct_2d": {
+        "description": "front speed U / sqrt(g' H) (theory 0.5, goal 0.43-0.52), 10% denser lock",
+        "error": lambda d: lock_exchange_speed(d, 0.10),
+        "extra": {},
+    },
     "cylinder_2d_re20": {
         "description": "relative C_D error vs Schaefer & Turek 2D-1 (5.5795), mean over t >= 2.5 s",
         "error": dfg_error,
