@@ -92,15 +92,29 @@ bool inside_polygon(const std::vector<Vec3d>& poly, double x, double y) {
 
 // The fluid block a point belongs to: the first whose region holds it (blocks listed earlier win
 // where regions overlap, so a slide can be cut out of the water around it); -1 for none.
-int block_of(const Scene& s, const Vec3d& x) {
-  for (std::size_t b = 0; b < s.fluids.size(); ++b) {
-    const FluidBlock& f = s.fluids[b];
-    bool in = true;
-    for (int k = 0; k < s.dimensions; ++k) in = in && x[k] >= f.box.min[k] && x[k] <= f.box.max[k];
-    if (in && !f.polygon.empty()) in = inside_polygon(f.polygon, x[0], x[1]);
-    if (in) return int(b);
-  }
+bool in_block(const Scene& s, const FluidBlock& f, const Vec3d& x) {
+  bool in = true;
+  for (int k = 0; k < s.dimensions; ++k) in = in && x[k] >= f.box.min[k] && x[k] <= f.box.max[k];
+  return in && (f.polygon.empty() || inside_polygon(f.polygon, x[0], x[1]));
+}
+
+int block_of(const Scene& s, const Vec3d& x, std::size_t first_n = ~std::size_t(0)) {
+  for (std::size_t b = 0; b < s.fluids.size() && b < first_n; ++b)
+    if (in_block(s, s.fluids[b], x)) return int(b);
   return -1;
+}
+
+// Some fluid regions overlap (a slide cut out of the water around it): their layered start must
+// count each point once, for the block that owns it.
+bool blocks_overlap(const Scene& s) {
+  for (std::size_t a = 0; a < s.fluids.size(); ++a)
+    for (std::size_t b = a + 1; b < s.fluids.size(); ++b) {
+      bool o = true;
+      for (int k = 0; k < s.dimensions; ++k)
+        o = o && s.fluids[a].box.min[k] < s.fluids[b].box.max[k] && s.fluids[b].box.min[k] < s.fluids[a].box.max[k];
+      if (o) return true;
+    }
+  return false;
 }
 
 // Hydrostatic gauge pressure at x under fluid blocks of several densities (layers) [Pa]: the
@@ -115,13 +129,13 @@ double layered_pressure(const Scene& s, const sph::PhysicsParams& p, const Vec3d
   bool polygons = false;
   for (const auto& f : s.fluids) polygons = polygons || !f.polygon.empty();
   double pressure = 0;
-  if (!polygons) {
+  if (!polygons && !blocks_overlap(s)) {
     for (std::size_t b = 0; b < s.fluids.size(); ++b)
       pressure += double(p.materials[block_material[b]].eos.rest_density) * g *
                   ray_length_in_box(x, up, s.fluids[b].box, s.dimensions);
     return pressure;
   }
-  // Polygons (which may overlap boxes, earlier blocks winning): midpoint rule along the vertical in
+  // Polygons or overlapping blocks (earlier blocks winning): midpoint rule along the vertical in
   // steps of dx/8 up to the top of all blocks.
   double top = -1e300;
   for (const auto& f : s.fluids)
@@ -407,6 +421,7 @@ sph::PhysicsParams physics_params(const Scene& scene) {
       p.periodic = true;
       p.period[k] = sph::Real(scene.domain->max[std::size_t(k)] - scene.domain->min[std::size_t(k)]);
       p.periodic_origin[k] = sph::Real(scene.domain->min[std::size_t(k)]);
+      p.periodic_end[k] = sph::Real(scene.domain->max[std::size_t(k)]);
     }
   }
   for (int k = 0; k < 3; ++k) p.hydrostatic_gravity[k] = p.period[k] > 0 ? sph::Real(0) : p.gravity[k];
@@ -586,7 +601,11 @@ void Simulation::build_particles() {
         for (long i = i0; i < i1; ++i) lattice.push_back({(double(i) + 0.5) * dx, (double(j) + 0.5) * dx, 0.0});
     }
     for (const auto& x : lattice) {
-      if (block_of(s, x) != this_block) continue;  // outside its polygon, or an earlier block's
+      // Outside its polygon, or an earlier block's point. (A box's own lattice is not tested
+      // against its own box: its last row may lie an ulp beyond max.)
+      if ((!f.polygon.empty() && !inside_polygon(f.polygon, x[0], x[1])) ||
+          block_of(s, x, std::size_t(this_block)) >= 0)
+        continue;
       if (carver.blocks(x)) {
         ++summary_.fluid_removed_by_structures;
         carved.push_back(x);

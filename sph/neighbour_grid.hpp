@@ -37,9 +37,9 @@ struct GridView {
     for (int k = 0; k < D; ++k) {
       const Real f = (x[k] - origin[k]) * inv_cell[k];
       if (!(f >= Real(0) && f < Real(cells[k]))) {
-        // A wrapped coordinate may round onto the upper face of a periodic axis: last cell.
-        if (period[k] == Real(0) || !(f >= Real(0) && f <= Real(cells[k]))) return false;
-        c[k] = cells[k] - 1;
+        // A wrapped coordinate may round onto a face of a periodic axis: the edge cell.
+        if (period[k] == Real(0) || !(f >= Real(-1e-3) && f <= Real(cells[k]))) return false;
+        c[k] = f < Real(0) ? 0 : cells[k] - 1;
         continue;
       }
       c[k] = int(f);

@@ -186,24 +186,26 @@ struct DriftPass {
   Real dt;
   Real wall_rho_min;  // TaitEos::no_tension_density of the wall material
   bool periodic = false;
-  Real lo[3] = {0, 0, 0}, period[3] = {0, 0, 0};
+  Real lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, period[3] = {0, 0, 0};
 
   DriftPass(const ParticleView<D>& view, Real step, Real rho_min, const PhysicsParams& prm)
       : P(view), dt(step), wall_rho_min(rho_min), periodic(prm.periodic) {
     for (int a = 0; a < 3; ++a) {
       lo[a] = prm.periodic_origin[a];
+      hi[a] = prm.periodic_end[a];
       period[a] = prm.period[a];
     }
   }
-  // Back into [lo, lo + period) on periodic axes (a fluid particle moves far less than a period
-  // per step). A coordinate that rounds onto the upper face goes to the lower one.
+  // Back into [lo, hi) on periodic axes (a fluid particle moves far less than a period per step),
+  // hi the domain's upper face as the sort tests it. Float rounding of x -/+ period can land just
+  // outside either face: clamped to the lower face then.
   TURBID_HD Vec<D> wrap(Vec<D> x) const {
     for (int a = 0; a < D; ++a) {
       if (period[a] == Real(0)) continue;
-      const Real hi = lo[a] + period[a];
-      if (x[a] >= hi) x[a] -= period[a];
+      if (x[a] >= hi[a]) x[a] -= period[a];
       else if (x[a] < lo[a]) x[a] += period[a];
-      if (!(x[a] < hi)) x[a] = lo[a];
+      if (x[a] < lo[a]) x[a] = lo[a];
+      if (!(x[a] < hi[a])) x[a] = lo[a];
     }
     return x;
   }

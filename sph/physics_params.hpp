@@ -85,6 +85,7 @@ struct PhysicsParams {
   bool periodic = false;
   Real period[3] = {0, 0, 0};         // [m]
   Real periodic_origin[3] = {0, 0, 0}; // [m]
+  Real periodic_end[3] = {0, 0, 0};    // the domain's upper face, as the sort tests it [m]
   // Some material is not Newtonian: a rheology pass computes each fluid particle's shear rate and
   // effective viscosity before the momentum pass (fields shear_rate, effective_viscosity, shear_stress).
   bool rheology = false;

@@ -16,6 +16,7 @@
 #include "sph/backend.hpp"
 #include "sph/fields.hpp"
 #include "sph/particle_store.hpp"
+#include "sph/passes.hpp"
 #include "sph/vec.hpp"
 
 namespace {
@@ -295,6 +296,29 @@ TEST(NeighbourGrid, PeriodicAxisShorterThanThreeSupportsIsRefused) {
   EXPECT_THROW(GridLayout::make(d, 2, 0.04), std::runtime_error) << "0.1 m < 3 x 0.04 m";
   d.max[0] = 0.12;
   EXPECT_EQ(GridLayout::make(d, 2, 0.04).cells[0], 3);
+}
+
+// The drift's wrap must land every coordinate in [min, max) of the domain as the sort tests it,
+// for any float domain (x - period can round below min, min + period above max): 2000 random
+// domains, coordinates just across either face. Reference: the sort keeps exactly [min, max].
+TEST(NeighbourGrid, PeriodicWrapLandsInsideTheSortedDomain) {
+  Rng rng(99u);
+  PhysicsParams p;
+  p.dimensions = 2;
+  p.periodic = true;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const Real lo = Real(-1 + 2 * rng.u01()), hi = lo + Real(0.1 + rng.u01());
+    p.period[0] = hi - lo;
+    p.periodic_origin[0] = lo;
+    p.periodic_end[0] = hi;
+    DriftPass<2> drift(ParticleView<2>{}, Real(0), Real(0), p);
+    for (Real d : {Real(0), Real(1e-7), Real(1e-5), Real(1e-3)}) {
+      for (Real x : {lo - d, hi + d, std::nextafter(lo, Real(-10)), hi, std::nextafter(hi, Real(10))}) {
+        const Real w = drift.wrap(Vec<2>{x, Real(0)})[0];
+        ASSERT_TRUE(w >= lo && w < hi) << "x = " << x << " wrapped to " << w << " outside [" << lo << ", " << hi << ")";
+      }
+    }
+  }
 }
 
 }  // namespace
