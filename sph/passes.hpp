@@ -416,19 +416,18 @@ struct ContinuityPass {
             diffuse = true;
           }
           if (diffuse) {
-            const Real rho_j = rho_d;
             if constexpr (Diff == Diffusion::molteni) {
-              drho += pair::diffusion_molteni(prm.diffusion_delta * h * Mi.sound_speed, rho_i, rho_j, vol_j, F);
+              drho += pair::diffusion_molteni(prm.diffusion_delta * h * Mi.sound_speed, rho_i, rho_d, vol_j, F);
             } else if constexpr (Diff == Diffusion::antuono) {
               // Across an interface the ghost stands for i's material: i's gradient at both ends.
               const Vec<D>& grad_j = P.material[j] == mat_i ? P.density_gradient[j] : P.density_gradient[i];
-              drho += pair::diffusion_antuono<D>(prm.diffusion_delta * h * Mi.sound_speed, rho_i, rho_j,
+              drho += pair::diffusion_antuono<D>(prm.diffusion_delta * h * Mi.sound_speed, rho_i, rho_d,
                                                  P.density_gradient[i], grad_j, rij, vol_j, F);
             } else {
               Real gr = 0;
               for (int k = 0; k < D; ++k) gr += prm.hydrostatic_gravity[k] * rij[k];
               const Real rho_h = pair::hydrostatic_difference(Mi.eos.rest_density, inv_gamma, hydro_k, gr);
-              drho += pair::diffusion_fourtakas(prm.diffusion_delta * Real(2) * h * Mi.sound_speed, rho_i, rho_j, rho_h,
+              drho += pair::diffusion_fourtakas(prm.diffusion_delta * Real(2) * h * Mi.sound_speed, rho_i, rho_d, rho_h,
                                                 r2, kEta2Factor * h * h, vol_j, F);
             }
           }
