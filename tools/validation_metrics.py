@@ -18,6 +18,9 @@ step when a definition changes.
                        and the cylinder against rho0 g V.
   buoyancy_3d          the same for the cube and the cylinder of scenes/buoyancy_3d.yaml,
                        mean over 0.6 s <= t <= 1 s.
+  poiseuille_*_2d      L2 error of the steady velocity profile (last VTK frame, bins of one
+                       spacing) against physics.md D6; also the plug half-width's relative error.
+  lock_exchange_*_2d   front speed U / sqrt(g' H) between x = 0.5 and 1.1 m.
 
 Run as a script, it plots the dam-break front of one or more runs against the experiment:
 
@@ -296,7 +299,84 @@ def lock_exchange_speed(run_dir, contrast, x_from=0.5, x_to=1.1, depth=0.2):
     return slope / math.sqrt(9.81 * contrast * depth)
 
 
+
+# ---------------------------------------------------------------------------------------------
+# Steady yield-stress Poiseuille flow (physics.md D6), from the last VTK frame of a run; the same
+# metric as tests/validation/test_poiseuille.cpp (keep the two in step).
+
+POISEUILLE_HALF_WIDTH = 0.01  # H [m]: plates at y = 0 and 2H
+# scene -> (G = rho g_x [Pa/m], tau_y [Pa], K [Pa s^n], n [-]), as in scenes/poiseuille_*_2d.yaml
+POISEUILLE_CASES = {
+    "poiseuille_bingham_2d": (1000 * 0.0556, 0.2224, 0.1, 1.0),
+    "poiseuille_hb_thinning_2d": (1000 * 0.043, 0.129, 0.145, 0.5),
+    "poiseuille_hb_thickening_2d": (1000 * 0.0238, 0.0714, 0.0454, 1.5),
+}
+
+
+def poiseuille_profile(run_dir):
+    """Bin centres y [m], mean u_x [m/s] and mean shear rate [1/s] of the fluid particles of the
+    last frame in bins of one spacing across the channel."""
+    from turbid_vtp import frames, read_vtp
+
+    report, _ = read_run(run_dir)
+    dx = report["particle_spacing"]
+    a = read_vtp(frames(run_dir)[-1][1])
+    fluid = a["kind"] == 0
+    y = a["Points"][fluid, 1].astype(float)
+    u = a["velocity"][fluid, 0].astype(float)
+    rate = a["shear_rate"][fluid].astype(float)
+    bins = int(round(2 * POISEUILLE_HALF_WIDTH / dx))
+    out = ([], [], [])
+    for b in range(bins):
+        sel = [k for k in range(len(y)) if b * dx <= y[k] < (b + 1) * dx]
+        if not sel:
+            continue
+        out[0].append((b + 0.5) * dx)
+        out[1].append(sum(u[k] for k in sel) / len(sel))
+        out[2].append(sum(rate[k] for k in sel) / len(sel))
+    return out
+
+
+def poiseuille_errors(run_dir, scene):
+    """L2 error of the steady profile and the relative error of the plug half-width (a line fitted
+    to the bins' shear rate^n where it exceeds 30% of its largest value, extrapolated to zero)."""
+    G, tau_y, K, n = POISEUILLE_CASES[scene]
+    H = POISEUILLE_HALF_WIDTH
+    y0 = tau_y / G
+    e = (n + 1) / n
+
+    def exact(y):
+        eta = max(abs(y - H), y0)
+        return n / (n + 1) * (G / K) ** (1 / n) * ((H - y0) ** e - (eta - y0) ** e)
+
+    ys, us, rates = poiseuille_profile(run_dir)
+    num = sum((u - exact(y)) ** 2 for y, u in zip(ys, us))
+    den = sum(exact(y) ** 2 for y in ys)
+    g = [r ** n for r in rates]
+    pts = [(abs(y - H), gk) for y, gk in zip(ys, g) if gk > 0.3 * max(g)]
+    me = sum(p[0] for p in pts) / len(pts)
+    mg = sum(p[1] for p in pts) / len(pts)
+    slope = sum((p[0] - me) * (p[1] - mg) for p in pts) / sum((p[0] - me) ** 2 for p in pts)
+    plug = me - mg / slope
+    return {"l2": math.sqrt(num / den), "plug": plug / y0 - 1}
+
+
 METRICS = {
+    "poiseuille_bingham_2d": {
+        "description": "L2 error of the steady velocity profile vs physics.md D6 (last frame)",
+        "error": lambda d: poiseuille_errors(d, "poiseuille_bingham_2d")["l2"],
+        "extra": {"plug_half_width_rel_error": lambda d: poiseuille_errors(d, "poiseuille_bingham_2d")["plug"]},
+    },
+    "poiseuille_hb_thinning_2d": {
+        "description": "L2 error of the steady velocity profile vs physics.md D6 (last frame)",
+        "error": lambda d: poiseuille_errors(d, "poiseuille_hb_thinning_2d")["l2"],
+        "extra": {"plug_half_width_rel_error": lambda d: poiseuille_errors(d, "poiseuille_hb_thinning_2d")["plug"]},
+    },
+    "poiseuille_hb_thickening_2d": {
+        "description": "L2 error of the steady velocity profile vs physics.md D6 (last frame)",
+        "error": lambda d: poiseuille_errors(d, "poiseuille_hb_thickening_2d")["l2"],
+        "extra": {"plug_half_width_rel_error": lambda d: poiseuille_errors(d, "poiseuille_hb_thickening_2d")["plug"]},
+    },
     "lock_exchange_5pct_2d": {
         "description": "front speed U / sqrt(g' H) (theory 0.5, goal 0.43-0.52), 5% denser lock",
         "error": lambda d: lock_exchange_speed(d, 0.05),
