@@ -15,6 +15,7 @@
 #include "sph/open_boundary.hpp"
 #include "sph/particle_store.hpp"
 #include "sph/physics_params.hpp"
+#include "sph/split_params.hpp"
 
 namespace turbid::sph {
 
@@ -58,6 +59,10 @@ class Backend {
   // Force and torque of the fluid on each structure, from the last force pass (the exact reaction
   // of the fluid's accelerations); reference[k] is the point structure k's torque is taken about.
   virtual std::vector<BodyLoad> body_loads(const std::vector<std::array<double, 3>>& reference) = 0;
+  // Splits the fluid particles that meet a rule (sph/splitting.hpp: flag, exclusive scan, ordered
+  // writes; mothers beyond the store's capacity are refused). Reads the shear stress of the last
+  // force pass. Afterwards the grid is stale: the caller updates neighbours and forces.
+  virtual SplitCounts split(const SplitParams& rules);
 };
 
 std::unique_ptr<Backend> make_cpu_backend(int threads);

@@ -39,6 +39,8 @@ std::unique_ptr<std::byte[]> zeroed(std::size_t bytes) {
 
 FieldId ParticleStore::add_field(FieldDesc desc) {
   if (find(desc.name)) throw std::invalid_argument("field registered twice: " + desc.name);
+  if (desc.carry == Carry::divide && desc.type != ScalarType::f32 && desc.type != ScalarType::f64)
+    throw std::invalid_argument("field '" + desc.name + "' carries to daughters by division but is not floating point");
   Field f{std::move(desc), nullptr};
   f.data = zeroed(capacity_ * scalar_size(f.desc.type) * std::size_t(f.desc.components));
   fields_.push_back(std::move(f));
@@ -130,6 +132,27 @@ std::size_t ParticleStore::compact(const std::uint8_t* keep) {
   const std::size_t removed = size_ - w;
   size_ = w;
   return removed;
+}
+
+void ParticleStore::copy_particle(std::size_t from, std::size_t to) {
+  for (auto& f : fields_) {
+    const std::size_t fb = scalar_size(f.desc.type) * std::size_t(f.desc.components);
+    std::memcpy(f.data.get() + to * fb, f.data.get() + from * fb, fb);
+  }
+}
+
+void ParticleStore::divide_shared(std::size_t i, int shares) {
+  for (auto& f : fields_) {
+    if (f.desc.carry != Carry::divide) continue;
+    const std::size_t c = std::size_t(f.desc.components);
+    if (f.desc.type == ScalarType::f32) {
+      float* v = reinterpret_cast<float*>(f.data.get()) + i * c;
+      for (std::size_t k = 0; k < c; ++k) v[k] /= float(shares);
+    } else if (f.desc.type == ScalarType::f64) {
+      double* v = reinterpret_cast<double*>(f.data.get()) + i * c;
+      for (std::size_t k = 0; k < c; ++k) v[k] /= double(shares);
+    }
+  }
 }
 
 }  // namespace turbid::sph

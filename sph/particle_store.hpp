@@ -73,6 +73,13 @@ class ParticleStore {
   // Keeps particles whose keep[i] != 0, in their order; returns how many were removed.
   std::size_t compact(const std::uint8_t* keep);
 
+  // Splitting (sph/splitting.hpp). Particle `to` becomes a copy of particle `from` in every field;
+  // safe to call concurrently for distinct `to`.
+  void copy_particle(std::size_t from, std::size_t to);
+  // Divides particle i's value of every floating-point field that carries by Carry::divide by
+  // `shares` (the daughters that share the mother's value).
+  void divide_shared(std::size_t i, int shares);
+
  private:
   struct Field {
     FieldDesc desc;

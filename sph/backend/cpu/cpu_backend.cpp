@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <stdexcept>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include "sph/boundary_passes.hpp"
 #include "sph/dispatch.hpp"
 #include "sph/passes.hpp"
+#include "sph/splitting.hpp"
 
 namespace turbid::sph {
 namespace {
@@ -103,6 +105,10 @@ class CpuBackend final : public Backend {
     return loads_impl<3>(reference);
   }
 
+  SplitCounts split(const SplitParams& rules) override {
+    return params_.dimensions == 2 ? split_impl<2>(rules) : split_impl<3>(rules);
+  }
+
   template <int D>
   std::vector<BodyLoad> loads_impl(const std::vector<std::array<double, 3>>& reference) {
     const ParticleView<D> P = view<D>();
@@ -110,6 +116,73 @@ class CpuBackend final : public Backend {
   }
 
  private:
+  // Splitting in the four steps of sph/splitting.hpp. The scan and the capacity test run on one
+  // thread (one add per particle); flags and writes in parallel, each mother writing only her own
+  // slots, so the result is the same for every thread count.
+  template <int D>
+  SplitCounts split_impl(const SplitParams& rules) {
+    SplitCounts c;
+    const std::uint32_t n = std::uint32_t(store_->size());
+    if (rules.rule_count == 0 || n == 0) return c;
+    new_slots_.resize(n);
+    rule_of_.resize(n);
+    first_slot_.resize(n);
+    {
+      const ParticleView<D> P = view<D>();
+      const GridView<D> G = grid<D>();
+      dispatch_kernel<D>(params_, [&](auto kernel_tag, auto uniform_tag) {
+        using K = typename decltype(kernel_tag)::type;
+        constexpr bool U = decltype(uniform_tag)::value;
+        parallel_for(n, SplitFlagPass<D, K, U>{P, G, params_, rules, new_slots_.data(), rule_of_.data()});
+      });
+    }
+    std::exclusive_scan(new_slots_.begin(), new_slots_.end(), first_slot_.begin(), std::uint64_t(0));
+    const std::uint64_t room = store_->capacity() - n;
+    std::uint64_t added = 0;
+    for (std::uint32_t i = 0; i < n; ++i) {
+      if (new_slots_[i] == 0) continue;
+      if (first_slot_[i] + new_slots_[i] <= room) {
+        ++c.splits;
+        added = first_slot_[i] + new_slots_[i];
+      } else {
+        ++c.refused;
+        new_slots_[i] = 0;
+      }
+    }
+    if (c.splits == 0) return c;
+    const std::uint32_t* id0 = store_->data<std::uint32_t>(ids_.id);
+    std::uint32_t next_id = 0;
+    const std::int64_t ni = n;
+#pragma omp parallel for reduction(max : next_id) schedule(static) if (ni >= kParallelThreshold)
+    for (std::int64_t i = 0; i < ni; ++i) next_id = std::max(next_id, id0[i] + 1);
+    store_->resize(n + added);  // within the capacity: the arrays stay where they are
+    const ParticleView<D> P = view<D>();
+    std::uint32_t* id = store_->data<std::uint32_t>(ids_.id);
+    const DriftPass<D> wrap{P, Real(0), Real(0), params_};
+    constexpr int kD = daughters_per_split<D>();
+    parallel_for(n, [&](std::uint32_t i) {
+      if (new_slots_[i] == 0) return;
+      const SplitRule& rule = rules.rules[rule_of_[i]];
+      const std::size_t base = std::size_t(n) + first_slot_[i];  // daughter k >= 1 goes to base + k - 1
+      const Vec<D> x0 = P.position[i];
+      const Real edge = split_edge<D>(P.mass[i], P.density[i]);
+      const Real h = P.smoothing_length[i];
+      for (int k = 1; k < kD; ++k) store_->copy_particle(i, base + std::size_t(k - 1));
+      for (int k = 0; k < kD; ++k) {
+        const std::size_t slot = k == 0 ? i : base + std::size_t(k - 1);
+        store_->divide_shared(slot, kD);
+        P.position[slot] = wrap.wrap(x0 + daughter_offset<D>(k, edge));
+        P.smoothing_length[slot] = Real(0.5) * h;
+        P.material[slot] = rule.to;
+        if (k > 0) id[slot] = next_id + std::uint32_t(first_slot_[i]) + std::uint32_t(k - 1);
+      }
+    });
+    c.daughters = added;
+    list_valid_ = false;
+    soa_valid_ = false;
+    return c;
+  }
+
   double max_h_ratio() const {
     // Largest h present relative to the initial h; splitting only halves h, so 1 for now.
     return 1.0;
@@ -359,6 +432,9 @@ class CpuBackend final : public Backend {
   std::size_t cell_count_ = 1;
   std::vector<std::uint32_t> cell_start_, cursor_, keys_, order_;
   std::vector<std::uint32_t> list_entries_, list_count_, fluid_before_;
+  std::vector<std::uint32_t> new_slots_;  // splitting: slots each particle asks for
+  std::vector<std::int8_t> rule_of_;      // splitting: the rule a particle meets, or -1
+  std::vector<std::uint64_t> first_slot_; // splitting: exclusive scan of new_slots_
   std::uint32_t list_stride_ = 0;
   bool list_valid_ = false;
   std::vector<Real> soa_;

@@ -1,0 +1,12 @@
+// Defaults of the Backend interface for what a backend may not offer yet.
+#include "sph/backend.hpp"
+
+#include <stdexcept>
+
+namespace turbid::sph {
+
+SplitCounts Backend::split(const SplitParams&) {
+  throw std::logic_error("particle splitting is not implemented on the " + name() + " backend yet");
+}
+
+}  // namespace turbid::sph
