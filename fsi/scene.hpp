@@ -138,12 +138,16 @@ struct ProbeSpec {
     max_speed,       // largest fluid particle speed [m/s]
     kinetic_energy,  // total fluid kinetic energy [J] (per metre of depth in 2D)
     fluid_particles, // number of fluid particles [-]
+    // free-surface elevation at a station [m]: the highest fluid (of `material`) along the vertical
+    // `axis` among particles horizontally within dx of `point`, see fsi/probes.cpp
+    surface_elevation,
   };
   std::string name;
   Type type = Type::max_speed;
-  std::string material;  // front_position: empty = any fluid
-  int axis = 0;          // front_position: 0 = x, 1 = y, 2 = z
-  Vec3d point{0, 0, 0};  // pressure
+  std::string material;  // front_position, surface_elevation: empty = any fluid
+  int axis = 0;          // front_position: 0 = x, 1 = y, 2 = z; surface_elevation: the vertical
+                         // (up is +axis; the reader sets the last axis, y in 2D, z in 3D)
+  Vec3d point{0, 0, 0};  // pressure: the point; surface_elevation: the station (its `axis` component unused)
   SourceLocation where;
 };
 

@@ -962,10 +962,10 @@ void Reader::read_probes(const Value& v, fsi::Scene& scene) const {
   std::vector<std::string> material_names;
   for (const auto& m : scene.materials) material_names.push_back(m.name);
   const std::vector<std::string> types = {"front_position", "pressure", "max_speed", "kinetic_energy",
-                                          "fluid_particles"};
+                                          "fluid_particles", "surface_elevation"};
   std::map<std::string, int> first_line;
   for (const Value& item : list(v)) {
-    MapView m(*this, item, {"name", "type", "material", "axis", "point"});
+    MapView m(*this, item, {"name", "type", "material", "axis", "point", "at"});
     fsi::ProbeSpec probe;
     probe.where = where(item.mark);
     const Value nv = m.need("name");
@@ -987,7 +987,8 @@ void Reader::read_probes(const Value& v, fsi::Scene& scene) const {
     std::vector<std::string> uses;
     if (probe.type == fsi::ProbeSpec::Type::front_position) uses = {"material", "axis"};
     if (probe.type == fsi::ProbeSpec::Type::pressure) uses = {"point"};
-    for (const char* key : {"material", "axis", "point"})
+    if (probe.type == fsi::ProbeSpec::Type::surface_elevation) uses = {"material", "at"};
+    for (const char* key : {"material", "axis", "point", "at"})
       if (m.has(key) && std::find(uses.begin(), uses.end(), key) == uses.end())
         fail(m.key_mark(key), "'" + std::string(key) + "' does not apply to a '" + types[t] + "' probe");
 
@@ -1004,6 +1005,31 @@ void Reader::read_probes(const Value& v, fsi::Scene& scene) const {
       probe.axis = static_cast<int>(choice(*av, axes, z_in_2d ? "a 2D scene has no z axis" : ""));
     }
     if (probe.type == fsi::ProbeSpec::Type::pressure) probe.point = point(m.need("point"), dims, "m");
+    if (probe.type == fsi::ProbeSpec::Type::surface_elevation) {
+      // The elevation is measured along the last axis (y in 2D, z in 3D), the one the default
+      // gravity points down; `at` gives the station's other coordinates. A scene whose gravity
+      // does not point mostly down that axis has no such vertical, so the probe is refused.
+      const int up = dims - 1;
+      const Vec3d& g = scene.gravity;
+      const bool down = g[std::size_t(up)] < 0 && std::abs(g[std::size_t(up)]) >= std::abs(g[0]) &&
+                        std::abs(g[std::size_t(up)]) >= std::abs(g[1]) && std::abs(g[std::size_t(up)]) >= std::abs(g[2]);
+      if (!down)
+        fail(tv.mark, "a 'surface_elevation' probe measures along " + std::string(kAxisName[up]) +
+                          " and needs gravity pointing mainly down that axis, got gravity [" + fmt(g[0]) + ", " +
+                          fmt(g[1]) + (dims == 3 ? ", " + fmt(g[2]) : std::string()) + "]");
+      probe.axis = up;
+      const Value at = m.need("at");
+      if (dims == 2) {
+        probe.point[0] = number({at.node, at.mark, "'at' (the station's x)"}, any_number(), "m");
+      } else {
+        Value a = at;
+        a.name = "'at' (the station's [x, y])";
+        if (!at.node.IsSequence() || at.node.size() != 2)
+          fail(at.mark, a.name + " must be a list of 2 numbers [x, y] in m, got " + describe(at.node));
+        const Vec3d xy = point(a, 2, "m");
+        probe.point = {xy[0], xy[1], 0.0};
+      }
+    }
     scene.probes.push_back(probe);
   }
 }

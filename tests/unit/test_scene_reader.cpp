@@ -107,6 +107,10 @@ const BadScene kBadScenes[] = {
     {"span_on_box.yaml", 9, 66, "'span' applies only to a fluid 'polygon'", "a span on a fluid box"},
     {"span_reversed.yaml", 9, 52, "'span' needs y_min < y_max, got y_min = 0.15 and y_max = 0",
      "an empty or reversed span"},
+    {"elevation_station_3d.yaml", 11, 46, "'at' (the station's [x, y]) must be a list of 2 numbers [x, y]",
+     "a 3D surface elevation station given as one number"},
+    {"elevation_sideways_gravity.yaml", 12, 23, "needs gravity pointing mainly down that axis",
+     "a surface elevation probe where y is not the vertical"},
     {"periodic_axis.yaml", 8, 50, "item 2 of 'periodic' must be 'x' or 'y', got 'z'", "a periodic z axis in 2D"},
     {"ratio_range.yaml", 4, 55, "'smoothing_ratio' must be a number in (0.5, 3], got 3.5",
      "a ratio outside its interval"},
@@ -352,8 +356,9 @@ TEST(SceneReader, GoodTank3dUsesTheDefaults) {
 }
 
 // A 3D scene built from extruded cross-sections: polygon and polyline vertices are (x, z) points
-// stored as (x, z, 0), spans across y, the polygons' bounding boxes take y from the span.
-// Then the scene builds: its particle counts follow from the lattice (see the comments).
+// stored as (x, z, 0), spans across y, the polygons' bounding boxes take y from the span, and
+// surface_elevation stations are (x, y) with the vertical z. Then the scene builds: its particle
+// counts follow from the lattice (see the comments) and its probes read the still-water level.
 TEST(SceneReader, GoodExtruded3dParsesAndBuilds) {
   const turbid::fsi::Scene s = read_scene_file(kData + "/good_scenes/extruded_3d.yaml");
   using turbid::fsi::WallSpec;
@@ -377,6 +382,12 @@ TEST(SceneReader, GoodExtruded3dParsesAndBuilds) {
   EXPECT_DOUBLE_EQ(s.fluids[1].box.max[1], 0.1);
   EXPECT_DOUBLE_EQ(s.fluids[1].box.min[2], 0.0);
   EXPECT_DOUBLE_EQ(s.fluids[1].box.max[2], 0.5);
+  ASSERT_EQ(s.probes.size(), 2u);
+  EXPECT_EQ(s.probes[0].type, turbid::fsi::ProbeSpec::Type::surface_elevation);
+  EXPECT_EQ(s.probes[0].axis, 2);
+  EXPECT_DOUBLE_EQ(s.probes[0].point[0], 0.6);
+  EXPECT_DOUBLE_EQ(s.probes[0].point[1], 0.05);
+  EXPECT_EQ(s.probes[1].material, "slide");
 
   turbid::fsi::Simulation sim(s, {"cpu", 1});
   const auto& sum = sim.summary();
@@ -384,9 +395,14 @@ TEST(SceneReader, GoodExtruded3dParsesAndBuilds) {
   // 250; its hypotenuse halves the cells it cuts (10 x 9 / 2 = 45 of 50 per row), so within 15%.
   EXPECT_NEAR(double(sum.particles_per_material[1]), 0.02 * 0.1 / 8e-6, 0.15 * 250);
   // Water: 1 x 0.5 minus the triangle below the slope (0.08) and the slide (0.02) = 0.40 m^2 on 5
-  // rows: 0.40 x 0.1 / 8e-6 = 5000; the slope cuts 20 cells per row in half (50 per row lost at
-  // most), so within 2%.
+  // rows: 0.40 x 0.1 / 8e-6 = 5000; the 20 cells per row whose centres lie on the slope count in
+  // or out (100 of 5000 at most), so within 2%.
   EXPECT_NEAR(double(sum.particles_per_material[0]), 0.40 * 0.1 / 8e-6, 0.02 * 5000);
+  const std::vector<double> v = sim.probe_values();
+  // At rest the probes read the block tops (the probe reports the top particle + dx/2): water
+  // 0.5 m, the slide's horizontal top 0.4 m; float rounding of the positions, 1e-6 m.
+  EXPECT_NEAR(v[0], 0.5, 1e-6);
+  EXPECT_NEAR(v[1], 0.4, 1e-6);
 }
 
 }  // namespace
