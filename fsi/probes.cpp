@@ -76,6 +76,27 @@ double evaluate(const Scene& scene, const ProbeSpec& probe, const sph::ParticleS
       for (std::size_t i = 0; i < n; ++i) c += fluid(i) ? 1 : 0;
       return double(c);
     }
+    case ProbeSpec::Type::surface_elevation: {
+      // Particles count for the station when their horizontal distance to it is below dx. A
+      // narrower band could miss every column (in 3D a disc must reach dx/sqrt(2) to hold a point of
+      // a square lattice however the station falls, and disordered particles wander by a fraction
+      // of dx); the kernel support 2h would average the surface over 4 dx and blunt a steep wave.
+      // Over dx the reading is off by at most the surface slope times dx.
+      // The value is the highest such particle's centre plus dx/2: a particle stands for a cell of
+      // height dx, so a block filled to height H (top row at H - dx/2) reads H at rest.
+      const int want = probe.material.empty() ? -1 : material_index(scene, probe.material);
+      const int up = probe.axis;
+      const double dx = scene.particle_spacing;
+      double best = -std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i < n; ++i) {
+        if (!fluid(i) || (want >= 0 && mat[i] != want)) continue;
+        double r2 = 0;
+        for (int k = 0; k < D; ++k)
+          if (k != up) r2 += (double(x[i][k]) - probe.point[k]) * (double(x[i][k]) - probe.point[k]);
+        if (r2 < dx * dx) best = std::max(best, double(x[i][up]));
+      }
+      return std::isfinite(best) ? best + 0.5 * dx : std::nan("");  // no fluid at the station: NaN
+    }
   }
   return std::nan("");
 }
@@ -89,6 +110,7 @@ const char* probe_unit(ProbeSpec::Type t) {
     case ProbeSpec::Type::max_speed: return "m/s";
     case ProbeSpec::Type::kinetic_energy: return "J";
     case ProbeSpec::Type::fluid_particles: return "1";
+    case ProbeSpec::Type::surface_elevation: return "m";
   }
   return "";
 }

@@ -1,4 +1,4 @@
-// Probe evaluation on the particle state (front positions, point pressures, maxima, energies).
+// Probe evaluation on the particle state (fronts, surface elevations, point pressures, maxima, energies).
 #pragma once
 #include <vector>
 

@@ -58,10 +58,16 @@ struct VelocityProfile {
   double mean = 0;  // [m/s]
 };
 
+// 3D scenes extrude 2D cross-sections: a fluid polygon or a polyline wall is given in the vertical
+// x-z plane (vertex = (x, z, 0), the plane's two coordinates in the first two slots, as in 2D) and
+// spans y from span[0] to span[1]. A flume's cross-section is what experiments draw, and this keeps
+// one polygon/polyline code path for both dimensions.
 struct FluidBlock {
   std::string material;
-  Box box;                       // the region; for a polygon its bounding box
-  std::vector<Vec3d> polygon;    // 2D: the region is this polygon (>= 3 vertices) instead of `box`
+  Box box;                       // the region; for a polygon its bounding box (3D: y from `span`)
+  std::vector<Vec3d> polygon;    // the region is this polygon (>= 3 vertices) instead of `box`:
+                                 // 2D vertices (x, y, 0); 3D the cross-section, vertices (x, z, 0)
+  std::array<double, 2> span{0, 0};  // 3D polygon: its extent across y [m] (min, max)
   VelocityProfile initial_velocity;  // across this block's box; none: at rest
   SourceLocation where;
 };
@@ -81,13 +87,15 @@ struct WallSpec {
   enum class Kind {
     container,  // layers of particles outside the faces of `box` (a tank); faces in `open` are left out
     solid_box,  // `box` filled with boundary particles (an obstacle); with `layers`, only a shell that thick
-    polyline,   // 2D: a chain of segments through `points`, layers on the side given by `side`
+    polyline,   // a chain of segments through `points`, layers on the side given by `side`
+                // (3D: the cross-section in the x-z plane, repeated across y over `span`)
   };
   Kind kind = Kind::container;
   Box box;
   // container faces left open, in the order -x, +x, -y, +y, -z, +z
   std::array<bool, 6> open{false, false, false, false, false, false};
-  std::vector<Vec3d> points;  // polyline vertices (2D)
+  std::vector<Vec3d> points;  // polyline vertices: 2D (x, y, 0); 3D (x, z, 0) in the x-z plane
+  std::array<double, 2> span{0, 0};  // 3D polyline: its extent across y [m] (min, max)
   bool closed = false;        // polyline: connect the last point to the first
   int side = -1;              // polyline: layers on the right (-1) or left (+1) of the direction of travel
   int layers = 0;             // number of particle layers; 0 = enough for the kernel support (solid_box: full)
@@ -130,12 +138,16 @@ struct ProbeSpec {
     max_speed,       // largest fluid particle speed [m/s]
     kinetic_energy,  // total fluid kinetic energy [J] (per metre of depth in 2D)
     fluid_particles, // number of fluid particles [-]
+    // free-surface elevation at a station [m]: the highest fluid (of `material`) along the vertical
+    // `axis` among particles horizontally within dx of `point`, see fsi/probes.cpp
+    surface_elevation,
   };
   std::string name;
   Type type = Type::max_speed;
-  std::string material;  // front_position: empty = any fluid
-  int axis = 0;          // front_position: 0 = x, 1 = y, 2 = z
-  Vec3d point{0, 0, 0};  // pressure
+  std::string material;  // front_position, surface_elevation: empty = any fluid
+  int axis = 0;          // front_position: 0 = x, 1 = y, 2 = z; surface_elevation: the vertical
+                         // (up is +axis; the reader sets the last axis, y in 2D, z in 3D)
+  Vec3d point{0, 0, 0};  // pressure: the point; surface_elevation: the station (its `axis` component unused)
   SourceLocation where;
 };
 

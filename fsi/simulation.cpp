@@ -80,6 +80,10 @@ double ray_length_in_box(const Vec3d& x, const Vec3d& u, const Box& b, int d) {
   return std::max(0.0, t1 - t0);
 }
 
+// The second axis of a polygon's or polyline's plane: y in 2D; in 3D the cross-section lies in the
+// vertical x-z plane and is extruded across y (scene.hpp).
+int section_axis(int dims) { return dims == 3 ? 2 : 1; }
+
 // Point strictly inside a 2D polygon (crossing number).
 bool inside_polygon(const std::vector<Vec3d>& poly, double x, double y) {
   bool in = false;
@@ -95,7 +99,7 @@ bool inside_polygon(const std::vector<Vec3d>& poly, double x, double y) {
 bool in_block(const Scene& s, const FluidBlock& f, const Vec3d& x) {
   bool in = true;
   for (int k = 0; k < s.dimensions; ++k) in = in && x[k] >= f.box.min[k] && x[k] <= f.box.max[k];
-  return in && (f.polygon.empty() || inside_polygon(f.polygon, x[0], x[1]));
+  return in && (f.polygon.empty() || inside_polygon(f.polygon, x[0], x[section_axis(s.dimensions)]));
 }
 
 int block_of(const Scene& s, const Vec3d& x, std::size_t first_n = ~std::size_t(0)) {
@@ -136,17 +140,20 @@ double layered_pressure(const Scene& s, const sph::PhysicsParams& p, const Vec3d
     return pressure;
   }
   // Polygons or overlapping blocks (earlier blocks winning): midpoint rule along the vertical in
-  // steps of dx/8 up to the top of all blocks.
+  // steps of dx/8 up to the top of all blocks. (In 2D the third components are 0, so the sums
+  // below are those of the plane, bit for bit.)
   double top = -1e300;
+  const int corners = s.dimensions == 3 ? 8 : 4;
   for (const auto& f : s.fluids)
-    for (int c = 0; c < 4; ++c) {
-      const Vec3d corner{(c & 1) ? f.box.max[0] : f.box.min[0], (c & 2) ? f.box.max[1] : f.box.min[1], 0.0};
-      top = std::max(top, corner[0] * up[0] + corner[1] * up[1]);
+    for (int c = 0; c < corners; ++c) {
+      const Vec3d corner{(c & 1) ? f.box.max[0] : f.box.min[0], (c & 2) ? f.box.max[1] : f.box.min[1],
+                         s.dimensions == 3 ? ((c & 4) ? f.box.max[2] : f.box.min[2]) : 0.0};
+      top = std::max(top, corner[0] * up[0] + corner[1] * up[1] + corner[2] * up[2]);
     }
-  const double length = top - (x[0] * up[0] + x[1] * up[1]);
+  const double length = top - (x[0] * up[0] + x[1] * up[1] + x[2] * up[2]);
   const double step = s.particle_spacing / 8;
   for (double t = 0.5 * step; t < length; t += step) {
-    const int b = block_of(s, {x[0] + t * up[0], x[1] + t * up[1], 0.0});
+    const int b = block_of(s, {x[0] + t * up[0], x[1] + t * up[1], x[2] + t * up[2]});
     if (b >= 0) pressure += double(p.materials[block_material[std::size_t(b)]].eos.rest_density) * g * step;
   }
   return pressure;
@@ -185,7 +192,12 @@ Point ghost_solid_box(const Box& box, const Point& x, int d) {
   return n;
 }
 
-Point ghost_polyline(const WallSpec& w, const Point& x) {
+// In 3D the wall is the cross-section's polyline extruded across y: the nearest surface point is
+// the nearest point of the polyline in the x-z plane at the particle's own y, so the ghost offset
+// has no y component.
+Point ghost_polyline(const WallSpec& w, const Point& x3, int d) {
+  const int v = section_axis(d);
+  const Point x{x3[0], x3[v], 0.0};  // in the section's plane
   double best = std::numeric_limits<double>::infinity();
   Point q_best = x;
   const std::size_t n = w.points.size();
@@ -202,7 +214,8 @@ Point ghost_polyline(const WallSpec& w, const Point& x) {
       q_best = q;
     }
   }
-  return {2.0 * (q_best[0] - x[0]), 2.0 * (q_best[1] - x[1]), 0.0};
+  const Point g{2.0 * (q_best[0] - x[0]), 2.0 * (q_best[1] - x[1]), 0.0};
+  return d == 3 ? Point{g[0], 0.0, g[1]} : g;
 }
 
 // Initial velocity of a fluid block at x: along the profile's axis, uniform or parabolic across
@@ -588,7 +601,10 @@ void Simulation::build_particles() {
     std::vector<Point> carved;
     const int this_block = int(&f - s.fluids.data());
     // A polygon takes the points of the lattice anchored at the origin that fall inside it, so
-    // that polygons next to each other (a slide in the water around it) share one lattice.
+    // that polygons next to each other (a slide in the water around it) share one lattice. In 3D
+    // that is the lattice of its x-z plane, repeated across y as a box with the span's extent
+    // would be (geometry::extrude_across_y), so it meets tank walls and boxes on the same y rows.
+    const int v = section_axis(d);
     std::vector<Point> lattice;
     if (f.polygon.empty()) {
       lattice = geometry::fill_box(to_aabb(f.box), dx, d);
@@ -596,14 +612,15 @@ void Simulation::build_particles() {
       // (i + 1/2) dx, computed from the integer indices so that a box anchored at the origin
       // produces the very same coordinates.
       const long i0 = long(std::floor(f.box.min[0] / dx + 1e-9)), i1 = long(std::ceil(f.box.max[0] / dx - 1e-9));
-      const long j0 = long(std::floor(f.box.min[1] / dx + 1e-9)), j1 = long(std::ceil(f.box.max[1] / dx - 1e-9));
+      const long j0 = long(std::floor(f.box.min[v] / dx + 1e-9)), j1 = long(std::ceil(f.box.max[v] / dx - 1e-9));
       for (long j = j0; j < j1; ++j)
         for (long i = i0; i < i1; ++i) lattice.push_back({(double(i) + 0.5) * dx, (double(j) + 0.5) * dx, 0.0});
+      if (d == 3) lattice = geometry::extrude_across_y(lattice, f.span[0], f.span[1], dx);
     }
     for (const auto& x : lattice) {
       // Outside its polygon, or an earlier block's point. (A box's own lattice is not tested
       // against its own box: its last row may lie an ulp beyond max.)
-      if ((!f.polygon.empty() && !inside_polygon(f.polygon, x[0], x[1])) ||
+      if ((!f.polygon.empty() && !inside_polygon(f.polygon, x[0], x[v])) ||
           block_of(s, x, std::size_t(this_block)) >= 0)
         continue;
       if (carver.blocks(x)) {
@@ -646,7 +663,11 @@ void Simulation::build_particles() {
     switch (w.kind) {
       case WallSpec::Kind::container: pts = geometry::container_walls(to_aabb(w.box), dx, d, layers, w.open); break;
       case WallSpec::Kind::solid_box: pts = geometry::box_shell(to_aabb(w.box), dx, d, w.layers); break;
-      case WallSpec::Kind::polyline: pts = geometry::polyline_walls(w.points, w.closed, dx, layers, w.side); break;
+      case WallSpec::Kind::polyline:
+        pts = geometry::polyline_walls(w.points, w.closed, dx, layers, w.side);
+        // 3D: the section's layers repeated on the y rows of a tank with the same y extent.
+        if (d == 3) pts = geometry::extrude_across_y(pts, w.span[0], w.span[1], dx);
+        break;
     }
     for (const auto& x : pts) {
       // Walls start at the hydrostatic density of the water above them, so the first steps carry
@@ -656,7 +677,7 @@ void Simulation::build_particles() {
       switch (w.kind) {
         case WallSpec::Kind::container: ghost = ghost_container(w.box, x, d); break;
         case WallSpec::Kind::solid_box: ghost = ghost_solid_box(w.box, x, d); break;
-        case WallSpec::Kind::polyline: ghost = ghost_polyline(w, x); break;
+        case WallSpec::Kind::polyline: ghost = ghost_polyline(w, x, d); break;
       }
       const double rho = layered ? layered_density(wall_eos, x, true) : wall_eos.hydrostatic_density(g, depth);
       items.push_back({x, rho, 0, sph::Kind::wall, ghost, sph::kNoBody, cell_volume});

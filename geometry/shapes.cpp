@@ -1,4 +1,4 @@
-// Lattice sampling of boxes, tank walls and 2D polylines; see shapes.hpp.
+// Lattice sampling of boxes, tank walls and 2D polylines, and extrusion across y; see shapes.hpp.
 #include "geometry/shapes.hpp"
 
 #include <cmath>
@@ -94,6 +94,17 @@ std::vector<Point> polyline_walls(const std::vector<Point>& v, bool closed, doub
         pts.push_back({a[0] + t * tx + off * nx, a[1] + t * ty + off * ny, 0.0});
       }
   }
+  return pts;
+}
+
+std::vector<Point> extrude_across_y(const std::vector<Point>& section, double y_min, double y_max, double dx) {
+  if (!(dx > 0)) throw std::invalid_argument("extrude_across_y: spacing must be positive");
+  if (!(y_max > y_min)) throw std::invalid_argument("extrude_across_y: the span needs y_min < y_max");
+  const int n = cells_along(y_max - y_min, dx);
+  std::vector<Point> pts;
+  pts.reserve(section.size() * std::size_t(n));
+  for (int k = 0; k < n; ++k)
+    for (const Point& p : section) pts.push_back({p[0], y_min + (k + 0.5) * dx, p[1]});
   return pts;
 }
 

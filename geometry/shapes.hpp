@@ -1,5 +1,5 @@
 // Point sets sampled from simple shapes: lattices filling boxes, wall layers around boxes and along
-// 2D polylines. Points carry no physics; the caller decides what they become.
+// 2D polylines, and the extrusion of such 2D point sets across y into 3D. Points carry no physics; the caller decides what they become.
 #pragma once
 #include <array>
 #include <vector>
@@ -31,5 +31,11 @@ std::vector<Point> container_walls(const Aabb& box, double dx, int dims, int lay
 // (side = -1: right of the direction of travel, +1: left), the first row dx/2 from the line.
 std::vector<Point> polyline_walls(const std::vector<Point>& vertices, bool closed, double dx, int layers,
                                   int side);
+
+// 3D from a cross-section: every point (a, b, 0) of a set in the vertical x-z plane becomes the
+// points (a, y_k, b), y_k = y_min + (k + 1/2) dx for k < max(1, round((y_max - y_min) / dx)): the
+// rule of fill_box and container_walls, so that an extruded set and a box or tank with the same y
+// extent share one lattice across y.
+std::vector<Point> extrude_across_y(const std::vector<Point>& section, double y_min, double y_max, double dx);
 
 }  // namespace turbid::geometry

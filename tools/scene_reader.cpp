@@ -10,6 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cerrno>
 #include <charconv>
@@ -286,6 +287,48 @@ class Reader {
           number({c, mark, "component " + std::string(kAxisName[k]) + " of " + v.name}, any_number(), unit);
     }
     return p;
+  }
+
+  // A vertex of a polygon or polyline: [x, y] in 2D; in 3D [x, z], a point of the cross-section in
+  // the vertical x-z plane that 'span' extrudes across y. Stored as (first, second, 0) either way.
+  Vec3d section_point(const Value& v, int dims) const {
+    if (dims == 2) return point(v, 2, "m");
+    if (!v.node.IsSequence() || v.node.size() != 2)
+      fail(v.mark, v.name + " must be a list of 2 numbers [x, z] in m (in 3D a polygon or polyline is a cross-section "
+                            "in the x-z plane, extruded across y by 'span'), got " + describe(v.node));
+    Vec3d p{0, 0, 0};
+    for (std::size_t k = 0; k < 2; ++k) {
+      const YAML::Node c = v.node[k];
+      const YAML::Mark mark = c.IsNull() || c.Mark().is_null() ? v.mark : c.Mark();
+      p[k] = number({c, mark, "component " + std::string(k == 0 ? "x" : "z") + " of " + v.name}, any_number(), "m");
+    }
+    return p;
+  }
+
+  // The y extent of an extruded cross-section (3D): [y_min, y_max] with y_min < y_max. `map` holds
+  // the shape's keys; `shape` names it in messages. In 2D 'span' is refused, in 3D required.
+  std::array<double, 2> span(const MapView& map, int dims, const std::string& shape) const {
+    if (dims == 2) {
+      if (map.has("span"))
+        fail(map.key_mark("span"), "'span' applies only to 3D scenes (the y extent of an extruded " + shape +
+                                       "); a 2D " + shape + " is already in the scene's plane");
+      return {0, 0};
+    }
+    if (!map.has("span"))
+      fail(map.value().mark, "a 3D " + shape + " is a cross-section in the x-z plane extruded across y: " +
+                                 map.value().name + " needs 'span: [y_min, y_max]' [m]");
+    const Value sv = map.need("span");
+    if (!sv.node.IsSequence() || sv.node.size() != 2)
+      fail(sv.mark, "'span' must be a list of 2 numbers [y_min, y_max] in m, got " + describe(sv.node));
+    std::array<double, 2> r{};
+    for (std::size_t k = 0; k < 2; ++k) {
+      const YAML::Node c = sv.node[k];
+      const YAML::Mark mark = c.IsNull() || c.Mark().is_null() ? sv.mark : c.Mark();
+      r[k] = number({c, mark, std::string(k == 0 ? "y_min" : "y_max") + " of 'span'"}, any_number(), "m");
+    }
+    if (!(r[0] < r[1]))
+      fail(sv.mark, "'span' needs y_min < y_max, got y_min = " + fmt(r[0]) + " and y_max = " + fmt(r[1]));
+    return r;
   }
 
   // A flow direction along an axis: one of -x, +x, -y, +y (, -z, +z).
@@ -606,7 +649,7 @@ void Reader::read_walls(const Value& v, fsi::Scene& scene, std::vector<YAML::Mar
       if (m.has(s)) present.push_back(s);
     if (present.empty())
       fail(item.mark, item.name + " needs exactly one of 'box' (a container), 'solid_box' (an obstacle) or "
-                                  "'polyline' (2D), found none");
+                                  "'polyline', found none");
     if (present.size() > 1)
       fail(m.key_mark(present[1]), item.name + " has both '" + present[0] + "' and '" + present[1] +
                                        "'; give exactly one wall shape per item");
@@ -621,11 +664,9 @@ void Reader::read_walls(const Value& v, fsi::Scene& scene, std::vector<YAML::Mar
       wall.box = box(bv, dims);
       require_ordered(bv, wall.box, dims);
     } else {
-      if (dims != 2)
-        fail(m.key_mark("polyline"), "'polyline' walls exist only in 2D scenes, but this scene has dimensions: " +
-                                         std::to_string(dims) + "; use 'box' or 'solid_box'");
       wall.kind = fsi::WallSpec::Kind::polyline;
-      MapView pl(*this, m.need("polyline"), {"points", "closed", "side"});
+      MapView pl(*this, m.need("polyline"), {"points", "closed", "side", "span"});
+      wall.span = span(pl, dims, "polyline");
       if (auto c = pl.get("closed")) wall.closed = boolean(*c);
       if (auto s = pl.get("side")) wall.side = choice(*s, {"right", "left"}) == 0 ? -1 : +1;
       const Value pv = pl.need("points");
@@ -637,7 +678,7 @@ void Reader::read_walls(const Value& v, fsi::Scene& scene, std::vector<YAML::Mar
       for (std::size_t i = 0; i < points.size(); ++i) {
         Value p = points[i];
         p.name = "point " + std::to_string(i + 1) + " of 'points'";
-        wall.points.push_back(point(p, dims, "m"));
+        wall.points.push_back(section_point(p, dims));
         if (i > 0 && wall.points[i] == wall.points[i - 1])
           fail(p.mark, p.name + " repeats the point before it; a segment needs two distinct points");
       }
@@ -669,7 +710,7 @@ void Reader::read_fluids(const Value& v, fsi::Scene& scene, const std::vector<YA
   const std::vector<Value> items = list(v);
   if (items.empty()) fail(v.mark, "'fluids' must list at least one fluid block");
   for (const Value& item : items) {
-    MapView m(*this, item, {"material", "box", "polygon", "initial_velocity"});
+    MapView m(*this, item, {"material", "box", "polygon", "span", "initial_velocity"});
     fsi::FluidBlock block;
     block.where = where(item.mark);
     const Value mv = m.need("material");
@@ -680,19 +721,24 @@ void Reader::read_fluids(const Value& v, fsi::Scene& scene, const std::vector<YA
                         join(material_names) + ")");
     if (m.has("box") && m.has("polygon"))
       fail(m.key_mark("polygon"), "a fluid block has both 'box' and 'polygon'; give one shape");
+    if (m.has("span") && !m.has("polygon"))
+      fail(m.key_mark("span"), "'span' applies only to a fluid 'polygon' (the y extent of its extrusion in 3D)");
     if (auto pv = m.get("polygon")) {
-      // 2D: a region bounded by a polygon (for example a slide on a slope); checked below as its
-      // bounding box.
-      if (dims != 2) fail(pv->mark, "'polygon' fluid blocks are 2D only; in 3D use a 'box'");
+      // A region bounded by a polygon (for example a slide on a slope); in 3D a cross-section in
+      // the x-z plane extruded across y over 'span'. Checked below as its bounding box.
+      block.span = span(m, dims, "polygon");
       const std::vector<Value> pts = list(*pv);
       if (pts.size() < 3) fail(pv->mark, "a fluid 'polygon' needs at least 3 points, got " + std::to_string(pts.size()));
+      const std::size_t v = dims == 3 ? 2 : 1;  // the box axis of the section's second coordinate
       fsi::Box bb{{1e300, 1e300, 0}, {-1e300, -1e300, 0}};
+      if (dims == 3) bb = {{1e300, block.span[0], 1e300}, {-1e300, block.span[1], -1e300}};
       for (const Value& q : pts) {
-        block.polygon.push_back(point(q, dims, "m"));
-        for (int k = 0; k < 2; ++k) {
-          bb.min[k] = std::min(bb.min[k], block.polygon.back()[k]);
-          bb.max[k] = std::max(bb.max[k], block.polygon.back()[k]);
-        }
+        block.polygon.push_back(section_point(q, dims));
+        const Vec3d& p = block.polygon.back();
+        bb.min[0] = std::min(bb.min[0], p[0]);
+        bb.max[0] = std::max(bb.max[0], p[0]);
+        bb.min[v] = std::min(bb.min[v], p[1]);
+        bb.max[v] = std::max(bb.max[v], p[1]);
       }
       block.box = bb;
     }
@@ -916,10 +962,10 @@ void Reader::read_probes(const Value& v, fsi::Scene& scene) const {
   std::vector<std::string> material_names;
   for (const auto& m : scene.materials) material_names.push_back(m.name);
   const std::vector<std::string> types = {"front_position", "pressure", "max_speed", "kinetic_energy",
-                                          "fluid_particles"};
+                                          "fluid_particles", "surface_elevation"};
   std::map<std::string, int> first_line;
   for (const Value& item : list(v)) {
-    MapView m(*this, item, {"name", "type", "material", "axis", "point"});
+    MapView m(*this, item, {"name", "type", "material", "axis", "point", "at"});
     fsi::ProbeSpec probe;
     probe.where = where(item.mark);
     const Value nv = m.need("name");
@@ -941,7 +987,8 @@ void Reader::read_probes(const Value& v, fsi::Scene& scene) const {
     std::vector<std::string> uses;
     if (probe.type == fsi::ProbeSpec::Type::front_position) uses = {"material", "axis"};
     if (probe.type == fsi::ProbeSpec::Type::pressure) uses = {"point"};
-    for (const char* key : {"material", "axis", "point"})
+    if (probe.type == fsi::ProbeSpec::Type::surface_elevation) uses = {"material", "at"};
+    for (const char* key : {"material", "axis", "point", "at"})
       if (m.has(key) && std::find(uses.begin(), uses.end(), key) == uses.end())
         fail(m.key_mark(key), "'" + std::string(key) + "' does not apply to a '" + types[t] + "' probe");
 
@@ -958,6 +1005,31 @@ void Reader::read_probes(const Value& v, fsi::Scene& scene) const {
       probe.axis = static_cast<int>(choice(*av, axes, z_in_2d ? "a 2D scene has no z axis" : ""));
     }
     if (probe.type == fsi::ProbeSpec::Type::pressure) probe.point = point(m.need("point"), dims, "m");
+    if (probe.type == fsi::ProbeSpec::Type::surface_elevation) {
+      // The elevation is measured along the last axis (y in 2D, z in 3D), the one the default
+      // gravity points down; `at` gives the station's other coordinates. A scene whose gravity
+      // does not point mostly down that axis has no such vertical, so the probe is refused.
+      const int up = dims - 1;
+      const Vec3d& g = scene.gravity;
+      const bool down = g[std::size_t(up)] < 0 && std::abs(g[std::size_t(up)]) >= std::abs(g[0]) &&
+                        std::abs(g[std::size_t(up)]) >= std::abs(g[1]) && std::abs(g[std::size_t(up)]) >= std::abs(g[2]);
+      if (!down)
+        fail(tv.mark, "a 'surface_elevation' probe measures along " + std::string(kAxisName[up]) +
+                          " and needs gravity pointing mainly down that axis, got gravity [" + fmt(g[0]) + ", " +
+                          fmt(g[1]) + (dims == 3 ? ", " + fmt(g[2]) : std::string()) + "]");
+      probe.axis = up;
+      const Value at = m.need("at");
+      if (dims == 2) {
+        probe.point[0] = number({at.node, at.mark, "'at' (the station's x)"}, any_number(), "m");
+      } else {
+        Value a = at;
+        a.name = "'at' (the station's [x, y])";
+        if (!at.node.IsSequence() || at.node.size() != 2)
+          fail(at.mark, a.name + " must be a list of 2 numbers [x, y] in m, got " + describe(at.node));
+        const Vec3d xy = point(a, 2, "m");
+        probe.point = {xy[0], xy[1], 0.0};
+      }
+    }
     scene.probes.push_back(probe);
   }
 }

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "fsi/simulation.hpp"
 #include "tools/scene_reader.hpp"
 
 namespace {
@@ -82,7 +83,8 @@ const BadScene kBadScenes[] = {
      "a fluid box overlapping an obstacle"},
     {"fluid_outside_container.yaml", 12, 28, "pokes out of the container 'box' of item 1 of 'walls' (line 9) through its +x face",
      "a fluid box leaving the tank through a closed face"},
-    {"polyline_3d.yaml", 9, 5, "'polyline' walls exist only in 2D scenes", "a polyline wall in a 3D scene"},
+    {"polyline_3d.yaml", 9, 15, "'polyline' needs 'span: [y_min, y_max]'",
+     "a 3D polyline wall without the span of its extrusion, located at the polyline's map"},
     {"inverted_box.yaml", 9, 16, "'solid_box' needs min < max on every axis, got min x = 2 and max x = 1",
      "a box with min > max"},
     {"unknown_model.yaml", 8, 16, "'model' must be one of 'newtonian', 'bingham', 'herschel_bulkley', got 'binghm'; did "
@@ -97,7 +99,18 @@ const BadScene kBadScenes[] = {
     {"bingham_artificial.yaml", 7, 16, "needs the laminar viscosity term",
      "a non-Newtonian material with the artificial viscosity, located at its model"},
     {"polygon_two_points.yaml", 9, 32, "a fluid 'polygon' needs at least 3 points, got 2", "a degenerate polygon"},
-    {"polygon_3d.yaml", 9, 32, "'polygon' fluid blocks are 2D only", "a polygon fluid block in 3D"},
+    {"polygon_3d.yaml", 9, 5, "item 1 of 'fluids' needs 'span: [y_min, y_max]'",
+     "a 3D polygon fluid block without the span of its extrusion, located at the block"},
+    {"polygon_3d_xyz.yaml", 9, 41, "item 2 of 'polygon' must be a list of 2 numbers [x, z]",
+     "a 3D polygon vertex given as (x, y, z) instead of a cross-section point (x, z)"},
+    {"span_in_2d.yaml", 9, 58, "'span' applies only to 3D scenes", "a span on a 2D polygon"},
+    {"span_on_box.yaml", 9, 66, "'span' applies only to a fluid 'polygon'", "a span on a fluid box"},
+    {"span_reversed.yaml", 9, 52, "'span' needs y_min < y_max, got y_min = 0.15 and y_max = 0",
+     "an empty or reversed span"},
+    {"elevation_station_3d.yaml", 11, 46, "'at' (the station's [x, y]) must be a list of 2 numbers [x, y]",
+     "a 3D surface elevation station given as one number"},
+    {"elevation_sideways_gravity.yaml", 12, 23, "needs gravity pointing mainly down that axis",
+     "a surface elevation probe where y is not the vertical"},
     {"periodic_axis.yaml", 8, 50, "item 2 of 'periodic' must be 'x' or 'y', got 'z'", "a periodic z axis in 2D"},
     {"ratio_range.yaml", 4, 55, "'smoothing_ratio' must be a number in (0.5, 3], got 3.5",
      "a ratio outside its interval"},
@@ -340,6 +353,56 @@ TEST(SceneReader, GoodTank3dUsesTheDefaults) {
   EXPECT_TRUE(s.output.vtk);
   EXPECT_DOUBLE_EQ(s.output.every, 0.0);
   EXPECT_FALSE(s.domain.has_value());
+}
+
+// A 3D scene built from extruded cross-sections: polygon and polyline vertices are (x, z) points
+// stored as (x, z, 0), spans across y, the polygons' bounding boxes take y from the span, and
+// surface_elevation stations are (x, y) with the vertical z. Then the scene builds: its particle
+// counts follow from the lattice (see the comments) and its probes read the still-water level.
+TEST(SceneReader, GoodExtruded3dParsesAndBuilds) {
+  const turbid::fsi::Scene s = read_scene_file(kData + "/good_scenes/extruded_3d.yaml");
+  using turbid::fsi::WallSpec;
+  ASSERT_EQ(s.walls.size(), 2u);
+  EXPECT_EQ(s.walls[1].kind, WallSpec::Kind::polyline);
+  ASSERT_EQ(s.walls[1].points.size(), 2u);
+  EXPECT_DOUBLE_EQ(s.walls[1].points[0][0], 0.0);
+  EXPECT_DOUBLE_EQ(s.walls[1].points[0][1], 0.4);  // z of the first vertex
+  EXPECT_DOUBLE_EQ(s.walls[1].points[0][2], 0.0);
+  EXPECT_DOUBLE_EQ(s.walls[1].span[0], 0.0);
+  EXPECT_DOUBLE_EQ(s.walls[1].span[1], 0.1);
+  EXPECT_EQ(s.walls[1].side, -1);
+  ASSERT_EQ(s.fluids.size(), 2u);
+  EXPECT_EQ(s.fluids[0].polygon.size(), 3u);
+  EXPECT_DOUBLE_EQ(s.fluids[0].polygon[2][1], 0.2);  // z of (0.2, 0.2)
+  EXPECT_DOUBLE_EQ(s.fluids[0].span[1], 0.1);
+  // Bounding box: x and z from the section, y from the span.
+  EXPECT_DOUBLE_EQ(s.fluids[1].box.min[0], 0.0);
+  EXPECT_DOUBLE_EQ(s.fluids[1].box.max[0], 1.0);
+  EXPECT_DOUBLE_EQ(s.fluids[1].box.min[1], 0.0);
+  EXPECT_DOUBLE_EQ(s.fluids[1].box.max[1], 0.1);
+  EXPECT_DOUBLE_EQ(s.fluids[1].box.min[2], 0.0);
+  EXPECT_DOUBLE_EQ(s.fluids[1].box.max[2], 0.5);
+  ASSERT_EQ(s.probes.size(), 2u);
+  EXPECT_EQ(s.probes[0].type, turbid::fsi::ProbeSpec::Type::surface_elevation);
+  EXPECT_EQ(s.probes[0].axis, 2);
+  EXPECT_DOUBLE_EQ(s.probes[0].point[0], 0.6);
+  EXPECT_DOUBLE_EQ(s.probes[0].point[1], 0.05);
+  EXPECT_EQ(s.probes[1].material, "slide");
+
+  turbid::fsi::Simulation sim(s, {"cpu", 1});
+  const auto& sum = sim.summary();
+  // Slide: the triangle of legs 0.2 m (area 0.02 m^2) on 5 rows of 0.02 m, area x width / dx^3 =
+  // 250; its hypotenuse halves the cells it cuts (10 x 9 / 2 = 45 of 50 per row), so within 15%.
+  EXPECT_NEAR(double(sum.particles_per_material[1]), 0.02 * 0.1 / 8e-6, 0.15 * 250);
+  // Water: 1 x 0.5 minus the triangle below the slope (0.08) and the slide (0.02) = 0.40 m^2 on 5
+  // rows: 0.40 x 0.1 / 8e-6 = 5000; the 20 cells per row whose centres lie on the slope count in
+  // or out (100 of 5000 at most), so within 2%.
+  EXPECT_NEAR(double(sum.particles_per_material[0]), 0.40 * 0.1 / 8e-6, 0.02 * 5000);
+  const std::vector<double> v = sim.probe_values();
+  // At rest the probes read the block tops (the probe reports the top particle + dx/2): water
+  // 0.5 m, the slide's horizontal top 0.4 m; float rounding of the positions, 1e-6 m.
+  EXPECT_NEAR(v[0], 0.5, 1e-6);
+  EXPECT_NEAR(v[1], 0.4, 1e-6);
 }
 
 }  // namespace

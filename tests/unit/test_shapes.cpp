@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <vector>
 
 #include "geometry/shapes.hpp"
 
@@ -59,4 +61,24 @@ TEST(Shapes, BoxShellKeepsOnlyTheOuterLayers) {
   const Aabb box{{0, 0, 0}, {0.5, 0.5, 0.5}};
   EXPECT_EQ(turbid::geometry::box_shell(box, 0.1, 3, 1).size(), 98u);
   EXPECT_EQ(turbid::geometry::box_shell(box, 0.1, 3, 0).size(), 125u);  // layers <= 0: full
+}
+
+// Extrusion across y: the section's points on the rows a fluid box of the same y extent fills
+// (fill_box's rule), here 0.15 m at dx = 0.040625 m: round(3.69) = 4 rows at (k + 1/2) dx, the
+// x-z coordinates of the section kept.
+TEST(Shapes, ExtrusionRepeatsTheSectionOnTheRowsOfABox) {
+  const double dx = 0.040625;
+  const std::vector<Point> section{{0.1, 1.5, 0}, {0.3, 0.2, 0}};  // (x, z)
+  const auto pts = turbid::geometry::extrude_across_y(section, 0.0, 0.15, dx);
+  const auto rows = turbid::geometry::fill_box(Aabb{{0, 0, 0}, {dx, 0.15, dx}}, dx, 3);  // one column
+  ASSERT_EQ(rows.size(), 4u);
+  ASSERT_EQ(pts.size(), section.size() * rows.size());
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    for (std::size_t i = 0; i < section.size(); ++i) {
+      const Point& p = pts[k * section.size() + i];
+      EXPECT_EQ(p[0], section[i][0]);
+      EXPECT_NEAR(p[1], rows[k][1], 1e-12);
+      EXPECT_EQ(p[2], section[i][1]);
+    }
+  EXPECT_THROW(turbid::geometry::extrude_across_y(section, 0.15, 0.0, dx), std::invalid_argument);
 }

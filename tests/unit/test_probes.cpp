@@ -1,0 +1,98 @@
+// The surface_elevation probe (fsi/probes.cpp) on known particle sets: the initial lattice of a
+// flat-topped block. Reference: a block filled to height H has its top row at H - dx/2, and the
+// probe reports the top particle's centre plus dx/2, so it reads H up to float rounding of the
+// positions (1e-6 m here), far inside the half spacing the free surface is uncertain by.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "fsi/simulation.hpp"
+
+namespace {
+
+using namespace turbid;
+
+fsi::MaterialSpec material(const char* name, double density) {
+  fsi::MaterialSpec m;
+  m.name = name;
+  m.density = density;
+  m.sound_speed = 30;
+  return m;
+}
+
+fsi::ProbeSpec elevation(const char* name, double x, double y = 0, const char* material_name = "") {
+  fsi::ProbeSpec p;
+  p.name = name;
+  p.type = fsi::ProbeSpec::Type::surface_elevation;
+  p.point = {x, y, 0};
+  p.material = material_name;
+  return p;
+}
+
+constexpr double kRounding = 1e-6;  // float positions of O(1) m
+
+// 2D: mud up to 0.1 m under water up to 0.3 m, x from 0 to 1, dx = 0.01.
+fsi::Scene layered_2d() {
+  fsi::Scene s;
+  s.name = "flat";
+  s.dimensions = 2;
+  s.particle_spacing = 0.01;
+  s.gravity = {0, -9.81, 0};
+  s.materials = {material("water", 1000), material("mud", 1800)};
+  fsi::FluidBlock mud;
+  mud.material = "mud";
+  mud.box = {{0, 0, 0}, {1, 0.1, 0}};
+  fsi::FluidBlock water;
+  water.material = "water";
+  water.box = {{0, 0.1, 0}, {1, 0.3, 0}};
+  s.fluids = {mud, water};
+  return s;
+}
+
+TEST(SurfaceElevationProbe, FlatBlockReadsItsTopAndEachMaterialItsOwn) {
+  fsi::Scene s = layered_2d();
+  for (auto& p : std::vector<fsi::ProbeSpec>{elevation("eta", 0.5), elevation("mud_top", 0.5, 0, "mud"),
+                                             elevation("edge_in", 1.004), elevation("edge_out", 1.006),
+                                             elevation("away", 2.0)}) {
+    p.axis = 1;  // the vertical: y in 2D (the reader's choice)
+    s.probes.push_back(p);
+  }
+  fsi::Simulation sim(s, {"cpu", 1});
+  const std::vector<double> v = sim.probe_values();
+  ASSERT_EQ(v.size(), 5u);
+  EXPECT_NEAR(v[0], 0.3, kRounding) << "any fluid: the water's top";
+  EXPECT_NEAR(v[1], 0.1, kRounding) << "material mud: the top of the mud under the water";
+  // The band is horizontal distance < dx: the last column sits at x = 0.995, 0.009 m from a station
+  // at 1.004 (counted) and 0.011 m from one at 1.006 (not counted: no fluid there, NaN).
+  EXPECT_NEAR(v[2], 0.3, kRounding) << "a station within dx of the last column";
+  EXPECT_TRUE(std::isnan(v[3])) << "a station more than dx beyond the fluid: " << v[3];
+  EXPECT_TRUE(std::isnan(v[4])) << "a station far from any fluid: " << v[4];
+}
+
+TEST(SurfaceElevationProbe, ThreeDimensionalStationIsAnXyPoint) {
+  // 3D: water 1 m x 0.15 m up to z = 0.3 m, dx = 0.02; stations given as (x, y), vertical z.
+  fsi::Scene s;
+  s.name = "flat3d";
+  s.dimensions = 3;
+  s.particle_spacing = 0.02;
+  s.gravity = {0, 0, -9.81};
+  s.materials = {material("water", 1000)};
+  fsi::FluidBlock water;
+  water.material = "water";
+  water.box = {{0, 0, 0}, {1, 0.16, 0.3}};
+  s.fluids = {water};
+  for (auto p : {elevation("mid", 0.5, 0.075), elevation("corner", 0.001, 0.001), elevation("beside", 0.5, 0.2)}) {
+    p.axis = 2;
+    s.probes.push_back(p);
+  }
+  fsi::Simulation sim(s, {"cpu", 1});
+  const std::vector<double> v = sim.probe_values();
+  ASSERT_EQ(v.size(), 3u);
+  EXPECT_NEAR(v[0], 0.3, kRounding) << "station inside the block";
+  EXPECT_NEAR(v[1], 0.3, kRounding) << "station at the corner column (0.01, 0.01), 0.013 m < dx away";
+  // The last y row is at 0.15, 0.05 m from y = 0.2: beyond dx, so no fluid at that station.
+  EXPECT_TRUE(std::isnan(v[2])) << v[2];
+}
+
+}  // namespace
