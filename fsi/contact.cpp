@@ -3,14 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 
 namespace turbid::fsi {
 
 namespace {
-
-constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 // 1/x that maps infinity (a wall, a flat face, a rigid material) to 0.
 double reciprocal(double x) { return std::isinf(x) ? 0.0 : 1.0 / x; }

@@ -16,7 +16,11 @@
 //      the static elongation of the tangential spring, m g sin theta / k_t (the overshoot bound of
 //      a suddenly loaded undamped spring; damping only lowers it), over 0.5 s in which sliding
 //      would cover metres;
-//  (e) the tangential force never exceeds mu F_n.
+//  (e) the tangential force never exceeds mu F_n;
+//  (f) contact torque: a sphere launched sliding without spin on a level floor rolls after
+//      t = 2 v0 / (7 mu g) at v = 5/7 v0 (Coulomb friction decelerates it by mu g and spins it up
+//      by 5 mu g / (2 R)); the final speed within 1% and the contact point at rest (|v - w (R -
+//      delta/2)| below 1e-3 v0) after three times that.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -263,6 +267,43 @@ TEST(Contact, SphereWithoutRollingStaysPutOnAGentleIncline) {
               2 * r.static_elongation);
   EXPECT_LT(std::abs(r.displacement), 2 * r.static_elongation);
   EXPECT_LT(r.max_friction_ratio, 1.0);  // it never slipped
+}
+
+TEST(Contact, SlidingSphereStartsRollingAtFiveSevenths) {
+  const double mu = 0.3, v0 = 1.0;
+  fsi::RigidBody body(sphere_properties(Vector3d::Zero()));
+  const double m = body.mass();
+  const fsi::ContactLaw law = floor_law(m, 0.5, mu);
+  const double k_n = 4.0 / 3.0 * law.effective_modulus * std::sqrt(law.effective_radius);
+  const double overlap = std::pow(m * kG / k_n, 2.0 / 3.0);
+  body.set_position(Vector3d(0, 0, kRadius - overlap));
+  body.set_velocity(Vector3d(v0, 0, 0));
+  const double dt = fsi::contact_time_step(law, std::sqrt(2 * kG * overlap));
+  fsi::TangentialSpring spring;
+  const auto load = [&] {
+    fsi::Wrench w;
+    w.force = m * Vector3d(0, 0, -kG);
+    const fsi::ContactGeometry g = fsi::sphere_plane(body.position(), kRadius, Vector3d::Zero(), Vector3d::UnitZ());
+    w += fsi::contact_wrench(fsi::contact_force(law, g.overlap, g.normal, body.velocity_at(g.point), spring, dt).force,
+                             g.point, &body, nullptr)
+             .on_a;
+    return w;
+  };
+  const double t_roll = 2 * v0 / (7 * mu * kG);
+  fsi::Wrench w = load();
+  for (int i = 0; i < int(3 * t_roll / dt); ++i) {
+    body.kick(0.5 * dt, w);
+    body.drift(dt);
+    w = load();
+    body.kick(0.5 * dt, w);
+  }
+  // The contact point lies R - delta/2 below the centre (the middle of the overlap).
+  const double lever = kRadius - 0.5 * (kRadius - body.position().z());
+  const double v = body.velocity().x(), wR = body.angular_velocity().y() * lever;
+  std::printf("  sliding sphere: v = %.5f m/s (5/7 v0 = %.5f), w R = %.5f m/s after %.3f s\n", v, 5.0 / 7.0 * v0, wR,
+              3 * t_roll);
+  EXPECT_NEAR(v, 5.0 / 7.0 * v0, 0.01 * 5.0 / 7.0 * v0);
+  EXPECT_NEAR(v, wR, 1e-3 * v0);
 }
 
 TEST(Contact, ContactTimeStepFollowsHertzDuration) {
