@@ -151,6 +151,26 @@ struct ProbeSpec {
   SourceLocation where;
 };
 
+// The debris-flow -> turbidity-current transition (seed paper sect. II.C): a particle of material
+// `from` whose effective shear stress sqrt(J2(tau)) passes the threshold splits into 2^D
+// daughters of material `to` (sph/splitting.hpp).
+struct TransitionSpec {
+  std::string from;
+  std::string to;                     // same reference density as `from` (splitting conserves density)
+  double shear_stress_threshold = 0;  // [Pa]
+  bool interface_only = true;         // where: interface (a fluid neighbour of another material) | anywhere
+  int levels = 1;                     // how many times a particle may split (daughters of level < levels split again)
+  SourceLocation where;
+};
+
+// Room reserved before the run for the particles splitting creates.
+struct CapacitySpec {
+  std::size_t max_particles = 0;  // > 0: this many particles in all
+  double factor = 2.0;            // else: factor x the initial particle count
+  bool error_when_full = false;   // on_full: error (stop the run) | warn (refuse the splits, go on)
+  SourceLocation where;
+};
+
 struct OutputSpec {
   double every = 0.0;           // output interval [s]; 0 = only the initial and final state
   bool vtk = true;              // write particles_NNNN.vtp and particles.pvd
@@ -191,6 +211,8 @@ struct Scene {
   std::vector<StructureSpec> structures;
   std::vector<OpenBoundarySpec> open_boundaries;
   std::vector<ProbeSpec> probes;
+  std::vector<TransitionSpec> transitions;
+  CapacitySpec capacity;  // used when the scene has transitions
   OutputSpec output;
   // Particles leaving this box are removed and counted. Default: the bounding box of all
   // initial particles, grown by 10% of its size on every side.

@@ -423,6 +423,13 @@ sph::PhysicsParams physics_params(const Scene& scene) {
       p.rheology = true;
     }
   }
+  if (!scene.transitions.empty()) {
+    // The criterion reads every fluid particle's effective shear stress, and daughters have half
+    // their mother's h: the rheology pass runs for Newtonian materials too, and every pass takes
+    // the per-particle h from the start.
+    p.rheology = true;
+    p.uniform_h = false;
+  }
   p.wall_material = 0;
   p.interface_correction = scene.numerics.interface_correction && p.material_count > 1;
   p.uniform_sound_speed = true;
@@ -490,6 +497,36 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
   tp.min_time_step = scene_.numerics.min_time_step;
   tp.density_ratio_limit = scene_.numerics.density_ratio_limit;
   solver_ = std::make_unique<sph::Solver>(store_, ids_, params_, summary_.domain, tp, std::move(backend));
+  if (!scene_.transitions.empty()) solver_->set_splitting(split_params(scene_), scene_.capacity.error_when_full);
+}
+
+sph::SplitParams split_params(const Scene& scene) {
+  sph::SplitParams sp;
+  if (int(scene.transitions.size()) > sph::kMaxSplitRules)
+    throw std::invalid_argument("at most " + std::to_string(sph::kMaxSplitRules) + " transitions are supported");
+  const double h0 = scene.smoothing_ratio * scene.particle_spacing;
+  const auto index = [&](const std::string& name) {
+    for (std::size_t m = 0; m < scene.materials.size(); ++m)
+      if (scene.materials[m].name == name) return std::uint8_t(m);
+    throw std::invalid_argument("transition names an unknown material '" + name + "'");
+  };
+  for (const auto& t : scene.transitions) {
+    sph::SplitRule& r = sp.rules[sp.rule_count++];
+    r.from = index(t.from);
+    r.to = index(t.to);
+    r.threshold = sph::Real(t.shear_stress_threshold);
+    r.interface_only = t.interface_only;
+    // A particle of level L (h = h0 / 2^L) may split while L < levels: h > h0 / 2^levels, with
+    // the bound halfway between the last level allowed and the first refused.
+    r.min_smoothing_length = sph::Real(1.5 * h0 / std::pow(2.0, t.levels));
+  }
+  return sp;
+}
+
+std::size_t particle_capacity(const Scene& scene, std::size_t initial) {
+  if (scene.transitions.empty()) return initial;
+  if (scene.capacity.max_particles > 0) return std::max(scene.capacity.max_particles, initial);
+  return std::size_t(std::ceil(scene.capacity.factor * double(initial)));
 }
 
 void Simulation::build_particles() {
@@ -747,6 +784,7 @@ void Simulation::build_particles() {
     }
   }
 
+  store_.reserve(particle_capacity(s, items.size()));
   store_.resize(items.size());
   auto* x = static_cast<sph::Real*>(store_.raw(ids_.position));
   auto* rho = store_.data<sph::Real>(ids_.density);

@@ -59,6 +59,10 @@ class Observer {
 // Resolves scene defaults (automatic sound speed, wall layers) and converts to engine parameters.
 sph::PhysicsParams physics_params(const Scene& scene);
 int wall_layers(const Scene& scene, const WallSpec& wall);
+// The splitting rules of the scene's transitions (material indices, level bound).
+sph::SplitParams split_params(const Scene& scene);
+// Particles the store reserves room for: the initial count, or with transitions the scene's capacity.
+std::size_t particle_capacity(const Scene& scene, std::size_t initial);
 
 class Simulation {
  public:
@@ -85,6 +89,9 @@ class Simulation {
     solver_->restore_open_boundary_counts(inflow, outflow);
   }
   double last_time_step() const { return solver_->last_time_step(); }
+  // Splitting since the start (transitions): splits, daughters, refused splits.
+  const sph::SplitCounts& split_totals() const { return solver_->split_totals(); }
+  void restore_split_totals(const sph::SplitCounts& c) { solver_->restore_split_totals(c); }
   double wall_seconds() const { return wall_seconds_; }
   double particle_steps_per_second() const;
 

@@ -52,6 +52,9 @@ struct MaterialParams {
   Real dynamic_viscosity;  // mu [Pa s]; non-Newtonian: the largest mu_eff allowed (the cap)
   Rheology rheology;       // mu_eff(shear rate); Newtonian: consistency = mu, no yield stress
   bool non_newtonian = false;
+  // Smallest h among this material's particles [m], for its time-step limits; 0: the lattice's h.
+  // Splitting lowers it for the materials daughters are made of.
+  Real min_smoothing_length = 0;
 };
 
 struct PhysicsParams {

@@ -3,20 +3,23 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace turbid::sph {
 
 double stable_time_step(const PhysicsParams& p, const TimeStepParams& t, double max_speed, double max_acceleration) {
-  const double h = p.smoothing_length;
-  double c_max = 0, nu_max = 0;
+  // Each material with the smallest h among its particles (daughters of a split have half their
+  // mother's); max_speed and max_acceleration are the largest over all fluid particles.
+  double dt = std::numeric_limits<double>::infinity();
   for (int m = 0; m < p.material_count; ++m) {
-    c_max = std::max(c_max, double(p.materials[m].sound_speed));
-    nu_max = std::max(nu_max, double(p.materials[m].dynamic_viscosity) / double(p.materials[m].eos.rest_density));
+    const MaterialParams& M = p.materials[m];
+    const double h = M.min_smoothing_length > 0 ? double(M.min_smoothing_length) : double(p.smoothing_length);
+    const double nu = double(M.dynamic_viscosity) / double(M.eos.rest_density);
+    dt = std::min(dt, t.cfl * h / (double(M.sound_speed) + max_speed));
+    if (max_acceleration > 0) dt = std::min(dt, t.cfl * std::sqrt(h / max_acceleration));
+    if (p.viscosity == Viscosity::laminar && nu > 0) dt = std::min(dt, t.viscous_factor * h * h / nu);
   }
-  double dt = t.cfl * h / (c_max + max_speed);
-  if (max_acceleration > 0) dt = std::min(dt, t.cfl * std::sqrt(h / max_acceleration));
-  if (p.viscosity == Viscosity::laminar && nu_max > 0) dt = std::min(dt, t.viscous_factor * h * h / nu_max);
   return dt;
 }
 
@@ -70,6 +73,38 @@ void Solver::step(double dt) {
   last_dt_ = dt;
   ++steps_;
   check("step");
+  if (split_.rule_count > 0) split();
+}
+
+void Solver::split() {
+  const SplitCounts c = backend_->split(split_);
+  split_totals_.splits += c.splits;
+  split_totals_.daughters += c.daughters;
+  split_totals_.refused += c.refused;
+  if (c.splits > 0) {
+    // Daughters have half their mother's h: their materials' time-step limits follow it.
+    split_totals_.smallest_h =
+        split_totals_.smallest_h > 0 ? std::min(split_totals_.smallest_h, c.smallest_h) : c.smallest_h;
+    lower_daughter_h(split_totals_.smallest_h);
+    // The grid and the accelerations are those of the particles before the split.
+    removed_ += backend_->update_neighbours();
+    backend_->compute_forces();
+    check("the split after step");
+  }
+  if (c.refused > 0 && split_error_when_full_) {
+    std::ostringstream os;
+    os << "particle capacity exhausted at step " << steps_ << " (t = " << time_ << " s): " << c.refused
+       << " splits refused (store full at " << store_.capacity()
+       << " particles); raise 'capacity' in the scene, or set on_full: warn to go on without them";
+    throw BlowUp(os.str());
+  }
+}
+
+void Solver::lower_daughter_h(double h) {
+  for (int r = 0; r < split_.rule_count; ++r) {
+    MaterialParams& M = params_.materials[split_.rules[r].to];
+    if (M.min_smoothing_length == Real(0) || Real(h) < M.min_smoothing_length) M.min_smoothing_length = Real(h);
+  }
 }
 
 void Solver::check(const char* phase) {

@@ -34,8 +34,9 @@ struct BlowUp : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// dt limits (Monaghan 1992; Morris et al. 1997): acoustic h / (c_max + v_max), force sqrt(h / a_max),
-// both times the CFL number, and the viscous limit factor * h^2 / nu_max for laminar viscosity.
+// dt limits (Monaghan 1992; Morris et al. 1997) for every material, with its own smallest h, sound
+// speed and (largest) viscosity: acoustic h / (c + v_max), force sqrt(h / a_max), both times the CFL
+// number, and the viscous limit factor * h^2 / nu for laminar viscosity.
 double stable_time_step(const PhysicsParams& p, const TimeStepParams& t, double max_speed, double max_acceleration);
 
 class Solver {
@@ -62,17 +63,33 @@ class Solver {
     outflow_ = outflow;
   }
   double last_time_step() const { return last_dt_; }
+  // Splitting (sph/splitting.hpp) after every step, by these rules; error_when_full: a refused
+  // split stops the run (BlowUp) instead of being counted.
+  void set_splitting(const SplitParams& rules, bool error_when_full) {
+    split_ = rules;
+    split_error_when_full_ = error_when_full;
+  }
+  const SplitCounts& split_totals() const { return split_totals_; }  // since the start of the run
+  void restore_split_totals(const SplitCounts& c) {
+    split_totals_ = c;
+    if (c.smallest_h > 0) lower_daughter_h(c.smallest_h);
+  }
   Backend& backend() { return *backend_; }
   const PhysicsParams& params() const { return params_; }
 
  private:
   void check(const char* phase);
+  void split();
+  void lower_daughter_h(double h);  // the rules' daughter materials have particles of this h [m]
 
   ParticleStore& store_;
   FieldIds ids_;
   PhysicsParams params_;
   TimeStepParams time_params_;
   std::unique_ptr<Backend> backend_;
+  SplitParams split_;
+  bool split_error_when_full_ = false;
+  SplitCounts split_totals_;
   double time_ = 0;
   double last_dt_ = 0;
   std::uint64_t steps_ = 0;

@@ -27,6 +27,7 @@ struct SplitCounts {
   std::size_t splits = 0;     // mothers split
   std::size_t daughters = 0;  // particles created, beyond the mothers' own slots
   std::size_t refused = 0;    // mothers that met the criterion but found no room in the store
+  double smallest_h = 0;      // smallest smoothing length among the daughters [m]; 0: no split
 };
 
 }  // namespace turbid::sph

@@ -90,6 +90,13 @@ class Writers final : public fsi::Observer {
   void on_checkpoint(fsi::Simulation& sim) override { save_checkpoint(sim); }
 
   void on_progress(const fsi::Simulation& sim) override {
+    // Splits refused for lack of room: said once per new batch, whatever the progress setting.
+    if (sim.split_totals().refused > refused_told_) {
+      std::fprintf(stderr, "%swarning: t = %.4g s: %zu splits refused so far, the particle store is full (%zu); "
+                   "raise 'capacity' in the scene\n", tty_ && progress_ ? "\n" : "", sim.time(),
+                   sim.split_totals().refused, sim.store().capacity());
+      refused_told_ = sim.split_totals().refused;
+    }
     if (!progress_) return;
     const double rate = sim.particle_steps_per_second();
     const double frac = sim.time() / sim.end_time();
@@ -124,6 +131,13 @@ class Writers final : public fsi::Observer {
     state["particle_steps"] = sim.particle_steps();
     state["inflow"] = sim.inflow();
     state["outflow"] = sim.outflow();
+    if (!sim.scene().transitions.empty()) {
+      const auto& c = sim.split_totals();
+      state["splits"] = c.splits;
+      state["daughters"] = c.daughters;
+      state["splits_refused"] = c.refused;
+      state["smallest_smoothing_length"] = c.smallest_h;
+    }
     state["wall_seconds"] = sim.wall_seconds();
     state["particle_spacing"] = sim.scene().particle_spacing;
     state["end_time"] = sim.scene().end_time;
@@ -142,6 +156,7 @@ class Writers final : public fsi::Observer {
   bool progress_;
   bool tty_;
   double last_plain_ = 0;
+  std::size_t refused_told_ = 0;  // splits refused that a warning has reported
   double wall_at_start_ = 0, time_at_start_ = 0;
   std::optional<CsvSeriesWriter> probes_;
   std::optional<CsvSeriesWriter> forces_;
@@ -227,8 +242,17 @@ std::string describe_scene(const fsi::Scene& scene) {
   for (int k = 0; k < scene.dimensions; ++k)
     if (s.domain.periodic[k]) os << ", periodic along " << "xyz"[k];
   os << "\n";
-  const double mib = double(total) * double(s.bytes_per_particle) / (1024.0 * 1024.0);
-  os << "memory           " << s.bytes_per_particle << " bytes/particle, about " << mib << " MiB\n";
+  for (const auto& t : scene.transitions)
+    os << "transition       " << t.from << " -> " << t.to << " where sqrt(J2) > " << t.shear_stress_threshold
+       << " Pa, " << (t.interface_only ? "at interfaces" : "anywhere") << ", " << (1 << scene.dimensions)
+       << " daughters (h/2), up to " << t.levels << (t.levels == 1 ? " level" : " levels") << "\n";
+  const std::size_t capacity = fsi::particle_capacity(scene, total);
+  const double mib = double(capacity) * double(s.bytes_per_particle) / (1024.0 * 1024.0);
+  os << "memory           " << s.bytes_per_particle << " bytes/particle, about " << mib << " MiB";
+  if (capacity > total)
+    os << " for the " << capacity << " particles reserved (" << (capacity - total) << " for daughters; on_full: "
+       << (scene.capacity.error_when_full ? "error" : "warn") << ")";
+  os << "\n";
   os << "end time         " << scene.end_time << " s, output every " << scene.output.every << " s\n";
   return os.str();
 }
@@ -315,6 +339,12 @@ nlohmann::json run_scene(const RunRequest& request) {
                  state.at("removed").get<std::uint64_t>(), state.at("output_index").get<std::uint64_t>(),
                  state.at("checkpoint_index").get<std::uint64_t>(), state.at("particle_steps").get<std::uint64_t>());
       sim.restore_open_boundary_counts(state.value("inflow", std::uint64_t(0)), state.value("outflow", std::uint64_t(0)));
+      sph::SplitCounts splits;
+      splits.splits = state.value("splits", std::size_t(0));
+      splits.daughters = state.value("daughters", std::size_t(0));
+      splits.refused = state.value("splits_refused", std::size_t(0));
+      splits.smallest_h = state.value("smallest_smoothing_length", 0.0);
+      sim.restore_split_totals(splits);
     } else {
       sim.start();
     }
@@ -334,6 +364,13 @@ nlohmann::json run_scene(const RunRequest& request) {
     report["buffer_particles"] = sim.summary().buffer_particles;
     report["inflow_particles"] = sim.inflow();
     report["outflow_particles"] = sim.outflow();
+  }
+  if (!scene.transitions.empty()) {
+    const auto& c = sim.split_totals();
+    report["capacity"] = sim.store().capacity();
+    report["splits"] = c.splits;
+    report["daughters_created"] = c.daughters;
+    report["splits_refused"] = c.refused;
   }
   report["steps"] = sim.steps();
   report["simulated_time"] = sim.time();

@@ -378,6 +378,8 @@ class Reader {
   void read_open_boundaries(const Value& v, fsi::Scene& scene) const;
   void read_probes(const Value& v, fsi::Scene& scene) const;
   void read_output(const Value& v, fsi::OutputSpec& out) const;
+  void read_transitions(const Value& v, fsi::Scene& scene) const;
+  void read_capacity(const Value& v, fsi::CapacitySpec& c) const;
 
   std::string file_;
   std::string relative_to_;  // directory of relative mesh paths; empty: the scene file's
@@ -446,7 +448,8 @@ Value MapView::need(std::string_view key) const {
 
 const std::vector<std::string> kTopKeys = {"name",   "dimensions", "resolution", "time",   "gravity",
                                            "numerics", "materials", "walls",     "structures", "fluids",
-                                           "open_boundaries", "probes", "output", "domain"};
+                                           "open_boundaries", "probes", "output", "domain", "transitions",
+                                           "capacity"};
 
 fsi::Scene Reader::read(const std::string& yaml_text) {
   std::vector<YAML::Node> documents;
@@ -521,6 +524,13 @@ fsi::Scene Reader::read(const std::string& yaml_text) {
     if (auto v = top.get("open_boundaries")) read_open_boundaries(*v, scene);
     read_fluids(top.need("fluids"), scene, wall_marks);
     if (auto v = top.get("probes")) read_probes(*v, scene);
+    if (auto v = top.get("transitions")) read_transitions(*v, scene);
+    if (auto v = top.get("capacity")) {
+      if (!top.has("transitions"))
+        fail(top.key_mark("capacity"), "'capacity' reserves room for particles that transitions create, but the "
+                                       "scene has no 'transitions'");
+      read_capacity(*v, scene.capacity);
+    }
     if (auto v = top.get("output")) read_output(*v, scene.output);
   } catch (const YAML::Exception& e) {
     // Walking a parsed tree should not throw; if yaml-cpp does, keep the promised message form.
@@ -579,6 +589,57 @@ void Reader::read_numerics(const Value& v, fsi::NumericsSpec& n) const {
   if (auto t = m.get("min_time_step")) n.min_time_step = number(*t, positive(), "s");
   // |rho / rho0 - 1| above this stops the run as a blow-up.
   if (auto t = m.get("max_density_variation")) n.density_ratio_limit = number(*t, positive());
+}
+
+// transitions: [{from, to, when: {effective_shear_stress_above}, where, split, levels}]
+void Reader::read_transitions(const Value& v, fsi::Scene& scene) const {
+  std::vector<std::string> names;
+  for (const auto& m : scene.materials) names.push_back(m.name);
+  const auto material = [&](const Value& mv, const std::string& item) -> const fsi::MaterialSpec& {
+    const std::string name = text(mv);
+    for (const auto& m : scene.materials)
+      if (m.name == name) return m;
+    fail(mv.mark, "unknown material '" + name + "' in " + item + did_you_mean(name, names) +
+                      " (defined materials: " + join(names) + ")");
+  };
+  const std::vector<Value> items = list(v);
+  if (items.empty()) fail(v.mark, "'transitions' must list at least one transition (or leave the key out)");
+  if (items.size() > 4) fail(items[4].mark, "at most 4 transitions are supported");
+  for (const Value& item : items) {
+    MapView m(*this, item, {"from", "to", "when", "where", "split", "levels"});
+    fsi::TransitionSpec t;
+    t.where = where(item.mark);
+    const Value fv = m.need("from"), tv = m.need("to");
+    const fsi::MaterialSpec& from = material(fv, item.name);
+    const fsi::MaterialSpec& to = material(tv, item.name);
+    t.from = from.name;
+    t.to = to.name;
+    if (t.from == t.to) fail(tv.mark, "'to' must name another material than 'from' ('" + t.from + "')");
+    if (from.density != to.density)
+      fail(tv.mark, "material '" + to.name + "' has density " + fmt(to.density) + " kg/m^3 but '" +
+                        from.name + "' has " + fmt(from.density) +
+                        " kg/m^3: splitting conserves density, so a transition needs equal reference densities");
+    for (const auto& other : scene.transitions)
+      if (other.from == t.from) fail(fv.mark, "material '" + t.from + "' already has a transition");
+    MapView when(*this, m.need("when"), {"effective_shear_stress_above"});
+    t.shear_stress_threshold = number(when.need("effective_shear_stress_above"), non_negative(), "Pa");
+    if (auto w = m.get("where")) t.interface_only = choice(*w, {"interface", "anywhere"}) == 0;
+    if (auto sp = m.get("split")) choice(*sp, {"cubic"}, "2^D daughters at the sub-cube centres");
+    if (auto lv = m.get("levels")) t.levels = integer(*lv, 1, "an integer from 1 to 4 (times a particle may split)");
+    if (t.levels > 4) fail(m.get("levels")->mark, "'levels' must be an integer from 1 to 4 (times a particle may split), got " + std::to_string(t.levels));
+    scene.transitions.push_back(t);
+  }
+}
+
+// capacity: {max_particles: N} or {factor: F}, on_full: warn | error
+void Reader::read_capacity(const Value& v, fsi::CapacitySpec& c) const {
+  MapView m(*this, v, {"max_particles", "factor", "on_full"});
+  c.where = where(v.mark);
+  if (m.has("max_particles") && m.has("factor"))
+    fail(m.key_mark("factor"), "'capacity' takes 'max_particles' or 'factor', not both");
+  if (auto mp = m.get("max_particles")) c.max_particles = std::size_t(integer(*mp, 1, "a whole number of particles >= 1"));
+  if (auto f = m.get("factor")) c.factor = number(*f, {"a number >= 1", [](double x) { return x >= 1.0; }});
+  if (auto of = m.get("on_full")) c.error_when_full = choice(*of, {"warn", "error"}) == 1;
 }
 
 void Reader::read_materials(const Value& v, fsi::Scene& scene) const {

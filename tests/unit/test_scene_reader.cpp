@@ -138,6 +138,14 @@ const BadScene kBadScenes[] = {
     {"structures.yaml", 11, 31, "mesh file 'meshes/pipe.stl' not found",
      "a missing mesh file is reported at its name, with where it was looked for"},
     {"structure_two_shapes.yaml", 11, 18, "has both 'box' and 'sphere'", "a structure with two shapes"},
+    {"transition_density.yaml", 13, 24, "material 'turbidity' has density 1100 kg/m^3 but 'debris' has 1950 kg/m^3: "
+     "splitting conserves density", "a transition between materials of different reference densities, at 'to'"},
+    {"transition_unknown_material.yaml", 13, 24, "unknown material 'turbidty' in item 1 of 'transitions'; did you mean "
+     "'turbidity'?", "a transition into an undefined material"},
+    {"capacity_without_transitions.yaml", 10, 1, "'capacity' reserves room for particles that transitions create",
+     "a capacity in a scene without transitions"},
+    {"transition_where.yaml", 13, 85, "'where' must be 'interface' or 'anywhere', got 'interfaces'",
+     "an unknown 'where' of a transition"},
     {"structure_no_lift_3d.yaml", 13, 19, "needs 'lift_direction'",
      "3D coefficients without a lift direction (2D takes the in-plane normal)"},
     {"inlet_too_thin.yaml", 11, 34, "less than the kernel support 2h = 0.04 m", "an inlet zone thinner than 2h"},

@@ -180,7 +180,9 @@ TEST_P(ValidationPoiseuilleSteady, ProfileAndPlugMatchAnalyticSolution) {
   const double err = l2_error(p, exact);
   EXPECT_LT(err, c.tolerance) << "L2 error of the steady profile";
   const double plug = plug_half_width(p, n);
-  if (c.plug_tolerance > 0) EXPECT_NEAR(plug, y0, c.plug_tolerance * y0) << "plug half-width [m]";
+  if (c.plug_tolerance > 0) {
+    EXPECT_NEAR(plug, y0, c.plug_tolerance * y0) << "plug half-width [m]";
+  }
   std::printf("%s, H/dx = %.0f: L2 error %.2f%%, plug half-width %.4g m (exact %.4g m, %+.1f%%)\n", c.scene,
               H / c.dx, 100 * err, plug, y0, 100 * (plug / y0 - 1));
 }

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 #include <vector>
@@ -150,6 +151,13 @@ class CpuBackend final : public Backend {
       }
     }
     if (c.splits == 0) return c;
+    {
+      const Real* h = store_->data<Real>(ids_.smoothing_length);
+      Real smallest = std::numeric_limits<Real>::max();
+      for (std::uint32_t i = 0; i < n; ++i)
+        if (new_slots_[i] != 0) smallest = std::min(smallest, Real(0.5) * h[i]);
+      c.smallest_h = smallest;
+    }
     const std::uint32_t* id0 = store_->data<std::uint32_t>(ids_.id);
     std::uint32_t next_id = 0;
     const std::int64_t ni = n;
