@@ -63,6 +63,7 @@ class Backend {
   // writes; mothers beyond the store's capacity are refused). Reads the shear stress of the last
   // force pass. Afterwards the grid is stale: the caller updates neighbours and forces.
   virtual SplitCounts split(const SplitParams& rules);
+  virtual bool supports_splitting() const { return false; }
 };
 
 std::unique_ptr<Backend> make_cpu_backend(int threads);

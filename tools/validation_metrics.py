@@ -361,22 +361,16 @@ def poiseuille_errors(run_dir, scene):
     return {"l2": math.sqrt(num / den), "plug": plug / y0 - 1}
 
 
+def poiseuille_metric(scene):
+    return {
+        "description": "L2 error of the steady velocity profile vs physics.md D6 (last frame)",
+        "error": lambda d: poiseuille_errors(d, scene)["l2"],
+        "extra": {"plug_half_width_rel_error": lambda d: poiseuille_errors(d, scene)["plug"]},
+    }
+
+
 METRICS = {
-    "poiseuille_bingham_2d": {
-        "description": "L2 error of the steady velocity profile vs physics.md D6 (last frame)",
-        "error": lambda d: poiseuille_errors(d, "poiseuille_bingham_2d")["l2"],
-        "extra": {"plug_half_width_rel_error": lambda d: poiseuille_errors(d, "poiseuille_bingham_2d")["plug"]},
-    },
-    "poiseuille_hb_thinning_2d": {
-        "description": "L2 error of the steady velocity profile vs physics.md D6 (last frame)",
-        "error": lambda d: poiseuille_errors(d, "poiseuille_hb_thinning_2d")["l2"],
-        "extra": {"plug_half_width_rel_error": lambda d: poiseuille_errors(d, "poiseuille_hb_thinning_2d")["plug"]},
-    },
-    "poiseuille_hb_thickening_2d": {
-        "description": "L2 error of the steady velocity profile vs physics.md D6 (last frame)",
-        "error": lambda d: poiseuille_errors(d, "poiseuille_hb_thickening_2d")["l2"],
-        "extra": {"plug_half_width_rel_error": lambda d: poiseuille_errors(d, "poiseuille_hb_thickening_2d")["plug"]},
-    },
+    **{scene: poiseuille_metric(scene) for scene in POISEUILLE_CASES},
     "lock_exchange_5pct_2d": {
         "description": "front speed U / sqrt(g' H) (theory 0.5, goal 0.43-0.52), 5% denser lock",
         "error": lambda d: lock_exchange_speed(d, 0.05),
@@ -453,6 +447,38 @@ def plot_dam_break(run_dirs, png, labels=None):
     plt.close(fig)
 
 
+def plot_lock_exchange(runs, png, labels=None, depth=0.2):
+    """Front position against time of lock-exchange runs; `runs` holds (run_dir, contrast) pairs.
+    Axes scaled by H and H / sqrt(g' H), so that every run's theory line is the same slope 0.5."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    for k, (run_dir, contrast) in enumerate(runs):
+        rows = read_csv(os.path.join(run_dir, "probes.csv"))
+        scale = math.sqrt(9.81 * contrast * depth)
+        t = [ti * scale / depth for ti in rows["time"]]
+        x = [xi / depth for xi in rows["front"]]
+        label = labels[k] if labels else run_dir
+        label += f" (U / sqrt(g'H) = {lock_exchange_speed(run_dir, contrast, depth=depth):.3f})"
+        ax.plot(t, x, "-", label=label)
+    x0 = 1.0
+    ax.plot([0, 25], [x0, x0 + 0.5 * 25], "k--", lw=0.8, label="slope 0.5 (Benjamin 1968)")
+    ax.axhspan(0.5 / depth, 1.1 / depth, color="0.9", zorder=0, label="fit range x = 0.5-1.1 m")
+    ax.set_xlabel("t sqrt(g' H) / H")
+    ax.set_ylabel("front position x_f / H")
+    ax.set_xlim(0, 25)
+    ax.set_ylim(0, 7.5)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, loc="upper left")
+    ax.set_title("lock exchange: front of the dense current")
+    fig.tight_layout()
+    fig.savefig(png, dpi=120)
+    plt.close(fig)
+
+
 def main(argv):
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -460,6 +486,10 @@ def main(argv):
     p.add_argument("runs", nargs="+", help="run directories of scenes/dam_break_2d.yaml")
     p.add_argument("--png", required=True)
     p.add_argument("--labels", help="comma-separated legend labels, one per run")
+    lx = sub.add_parser("plot-lock-exchange", help="plot the front of lock-exchange runs")
+    lx.add_argument("runs", nargs="+", help="RUN_DIR:CONTRAST pairs, e.g. runs/lx5:0.05")
+    lx.add_argument("--png", required=True)
+    lx.add_argument("--labels", help="comma-separated legend labels, one per run")
     e = sub.add_parser("error", help="print the metric of a run directory")
     e.add_argument("scene", choices=sorted(METRICS))
     e.add_argument("run")
@@ -473,6 +503,10 @@ def main(argv):
             dT, rms = dam_break_best_offset(run_dir)
             print(f"{run_dir}: RMS relative error {100 * dam_break_error(run_dir):.2f}%; "
                   f"shifted by the best offset dT = {dT:.3f}: {100 * rms:.2f}%")
+        print(f"wrote {args.png}")
+    elif args.command == "plot-lock-exchange":
+        runs = [(r.rsplit(":", 1)[0], float(r.rsplit(":", 1)[1])) for r in args.runs]
+        plot_lock_exchange(runs, args.png, args.labels.split(",") if args.labels else None)
         print(f"wrote {args.png}")
     elif args.command == "error":
         m = METRICS[args.scene]

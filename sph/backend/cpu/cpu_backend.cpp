@@ -106,6 +106,7 @@ class CpuBackend final : public Backend {
     return loads_impl<3>(reference);
   }
 
+  bool supports_splitting() const override { return true; }
   SplitCounts split(const SplitParams& rules) override {
     return params_.dimensions == 2 ? split_impl<2>(rules) : split_impl<3>(rules);
   }
