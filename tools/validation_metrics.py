@@ -469,7 +469,7 @@ def plot_lock_exchange(runs, png, labels=None, depth=0.2):
     ax.axhspan(0.5 / depth, 1.1 / depth, color="0.9", zorder=0, label="fit range x = 0.5-1.1 m")
     ax.set_xlabel("t sqrt(g' H) / H")
     ax.set_ylabel("front position x_f / H")
-    ax.set_xlim(0, 25)
+    ax.set_xlim(0, 15)
     ax.set_ylim(0, 7.5)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7, loc="upper left")
