@@ -99,6 +99,7 @@ struct WallSpec {
   bool closed = false;        // polyline: connect the last point to the first
   int side = -1;              // polyline: layers on the right (-1) or left (+1) of the direction of travel
   int layers = 0;             // number of particle layers; 0 = enough for the kernel support (solid_box: full)
+  bool free_slip = false;     // slip: free, the fluid slides along it (no viscous stress); default no-slip
   SourceLocation where;
 };
 

@@ -447,6 +447,7 @@ sph::PhysicsParams physics_params(const Scene& scene) {
   for (int k = 0; k < 3; ++k) p.hydrostatic_gravity[k] = p.period[k] > 0 ? sph::Real(0) : p.gravity[k];
   p.boundary = scene.numerics.boundary == BoundaryKind::mdbc ? sph::Boundary::mdbc : sph::Boundary::dbc;
   p.mdbc_no_slip = scene.numerics.no_slip;
+  for (const auto& w : scene.walls) p.free_slip_walls = p.free_slip_walls || w.free_slip;
   p.body_count = int(scene.structures.size());
   p.zone_count = int(scene.open_boundaries.size());
   for (std::size_t k = 0; k < scene.open_boundaries.size(); ++k) {
@@ -551,6 +552,7 @@ void Simulation::build_particles() {
     double volume = 0;               // particle volume [m^d]
     Point velocity{0, 0, 0};
     std::uint8_t zone = sph::kNoZone;
+    bool free_slip = false;          // a particle of a free-slip wall
   };
   std::vector<Item> items;
   summary_.particles_per_material.assign(s.materials.size(), 0);
@@ -722,7 +724,7 @@ void Simulation::build_particles() {
         case WallSpec::Kind::polyline: ghost = ghost_polyline(w, x, d); break;
       }
       const double rho = layered ? layered_density(wall_eos, x, true) : wall_eos.hydrostatic_density(g, depth);
-      items.push_back({x, rho, 0, sph::Kind::wall, ghost, sph::kNoBody, cell_volume});
+      items.push_back({x, rho, 0, sph::Kind::wall, ghost, sph::kNoBody, cell_volume, {0, 0, 0}, sph::kNoZone, w.free_slip});
     }
   }
   summary_.wall_particles = items.size() - summary_.fluid_particles;
@@ -801,6 +803,7 @@ void Simulation::build_particles() {
   auto* ghost = ids_.boundary_normal >= 0 ? static_cast<sph::Real*>(store_.raw(ids_.boundary_normal)) : nullptr;
   auto* body = ids_.body >= 0 ? store_.data<std::uint8_t>(ids_.body) : nullptr;
   auto* zone = ids_.zone >= 0 ? store_.data<std::uint8_t>(ids_.zone) : nullptr;
+  auto* slip = ids_.free_slip >= 0 ? store_.data<std::uint8_t>(ids_.free_slip) : nullptr;
   auto* vel = static_cast<sph::Real*>(store_.raw(ids_.velocity));
   for (std::size_t i = 0; i < items.size(); ++i) {
     for (int k = 0; k < d; ++k) x[i * std::size_t(d) + std::size_t(k)] = sph::Real(items[i].x[k]);
@@ -808,6 +811,7 @@ void Simulation::build_particles() {
       for (int k = 0; k < d; ++k) ghost[i * std::size_t(d) + std::size_t(k)] = sph::Real(items[i].ghost[k]);
     if (body) body[i] = items[i].body;
     if (zone) zone[i] = items[i].zone;
+    if (slip) slip[i] = items[i].free_slip ? 1 : 0;
     for (int k = 0; k < d; ++k) vel[i * std::size_t(d) + std::size_t(k)] = sph::Real(items[i].velocity[k]);
     rho[i] = sph::Real(items[i].density);
     mass[i] = sph::Real(items[i].density * items[i].volume);  // V = m / rho: dx^d on the lattice

@@ -48,6 +48,8 @@ FieldIds register_fields(ParticleStore& s, const PhysicsParams& p, bool structur
     f.shear_stress = s.add_field({"shear_stress", "Pa", ScalarType::f32, 1, true, false, false, Carry::recompute});
   }
   if (p.zone_count > 0) f.zone = s.add_field({"zone", "", ScalarType::u8, 1, true, true, true, Carry::copy});
+  if (p.free_slip_walls)
+    f.free_slip = s.add_field({"free_slip", "", ScalarType::u8, 1, false, true, true, Carry::copy});
   return f;
 }
 

@@ -14,6 +14,7 @@ struct FieldIds {
   FieldId viscous_velocity = -1;  // registered only for no-slip mDBC
   FieldId body = -1, structure_force = -1;  // registered only when the scene has structures
   FieldId zone = -1;                        // registered only with open boundaries
+  FieldId free_slip = -1;                   // registered only with free-slip walls (1: the particle's wall slips)
   FieldId shifting_velocity = -1;           // registered only with particle shifting
   FieldId shear_rate = -1, effective_viscosity = -1, shear_stress = -1;  // only with a non-Newtonian material
 };

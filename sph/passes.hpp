@@ -37,6 +37,7 @@ struct ParticleView {
   std::uint8_t* body = nullptr;        // only with structures: structure index (kNoBody for others)
   std::uint8_t* zone = nullptr;        // only with open boundaries: buffer zone index (kNoZone for others)
   Vec<D>* viscous_velocity = nullptr;  // only with no-slip mDBC: the velocity walls show the viscous terms
+  std::uint8_t* free_slip = nullptr;   // only with free-slip walls: 1 for their particles
   Vec<D>* shifting_velocity = nullptr; // only with particle shifting: u_s of fluid particles, added in the drift
   Real* shear_rate = nullptr;          // only with a non-Newtonian material: sqrt(2 D:D) [1/s]
   Real* effective_viscosity = nullptr; // only with a non-Newtonian material: mu_eff [Pa s]
@@ -561,6 +562,9 @@ struct RheologyPass {
     for_each_neighbour<D>(P, G, NeighbourList{}, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
       const Real h = pair_h<D, K>(P, prm, UniformH, h_i, j);
       if (!UniformH && r2 >= Real(4) * h * h) return;
+      // A free-slip wall holds no velocity of its own for the fluid's shear: it is left out (the
+      // difference form stays exact for a uniform velocity with the truncated support).
+      if (P.free_slip && P.free_slip[j]) return;
       const Real FV = K::f_inv(std::sqrt(r2), Real(1) / h) * P.mass[j] / P.density[j];
       const Vec<D> vji = viscous_velocity_of<D>(P, j) - vi;
       for (int a = 0; a < D; ++a)
@@ -600,6 +604,7 @@ TURBID_HD inline Vec<D> momentum_pair(const ParticleView<D>& P, const PhysicsPar
     return s * rij;
   }
   const bool fluid_j = P.kind[j] == std::uint8_t(Kind::fluid);
+  if (!fluid_j && P.free_slip && P.free_slip[j]) return s * rij;  // a free-slip wall exerts no shear
   const Real mu_j = !fluid_j ? mu_i : (P.effective_viscosity ? P.effective_viscosity[j] : Mj.dynamic_viscosity);
   return s * rij + pair::laminar_viscosity(m_j, mu_i, mu_j, rho_i, rho_j, r2, eta2, F) * vij;
 }

@@ -65,6 +65,9 @@ struct PhysicsParams {
   Boundary boundary = Boundary::dbc;
   bool mdbc_no_slip = false;   // mDBC: boundary velocity mirrors the fluid's (no-slip), else stays the wall's
   Real mdbc_wet_share = Real(0.5);  // mDBC: a ghost node with less fluid than this share of its support is dry
+  // Some walls are free-slip: their particles carry the `free_slip` field, and the viscous terms
+  // (laminar viscosity, velocity gradient) leave them out.
+  bool free_slip_walls = false;
   int body_count = 0;          // structures (particles of kind structure carry their index in `body`)
   int zone_count = 0;          // open-boundary buffer zones (buffer particles carry their index in `zone`)
   BufferZone zones[kMaxZones];

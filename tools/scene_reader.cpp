@@ -704,7 +704,7 @@ void Reader::read_walls(const Value& v, fsi::Scene& scene, std::vector<YAML::Mar
   const int dims = scene.dimensions;
   const std::vector<std::string> shapes = {"box", "solid_box", "polyline"};
   for (const Value& item : list(v)) {
-    MapView m(*this, item, {"box", "solid_box", "polyline", "open", "layers"});
+    MapView m(*this, item, {"box", "solid_box", "polyline", "open", "layers", "slip"});
     std::vector<std::string> present;
     for (const auto& s : shapes)
       if (m.has(s)) present.push_back(s);
@@ -756,6 +756,13 @@ void Reader::read_walls(const Value& v, fsi::Scene& scene, std::vector<YAML::Mar
       }
     }
     if (auto l = m.get("layers")) wall.layers = integer(*l, 1, "an integer >= 1");
+    if (auto sl = m.get("slip")) {
+      wall.free_slip = choice(*sl, {"no_slip", "free"}) == 1;
+      if (wall.free_slip && scene.numerics.viscosity != fsi::ViscosityKind::laminar)
+        fail(sl->mark, "'slip: free' acts on the laminar viscosity term; this scene uses artificial viscosity");
+      if (wall.free_slip && scene.numerics.boundary == fsi::BoundaryKind::mdbc && scene.numerics.no_slip)
+        fail(sl->mark, "'slip: free' is for DBC walls or mDBC without 'velocity: no_slip'");
+    }
     scene.walls.push_back(wall);
     wall_marks.push_back(item.mark);
   }

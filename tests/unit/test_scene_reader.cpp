@@ -144,6 +144,8 @@ const BadScene kBadScenes[] = {
      "'turbidity'?", "a transition into an undefined material"},
     {"capacity_without_transitions.yaml", 10, 1, "'capacity' reserves room for particles that transitions create",
      "a capacity in a scene without transitions"},
+    {"slip_artificial.yaml", 9, 45, "'slip: free' acts on the laminar viscosity term",
+     "a free-slip wall where there is no laminar viscosity"},
     {"transition_where.yaml", 13, 85, "'where' must be 'interface' or 'anywhere', got 'interfaces'",
      "an unknown 'where' of a transition"},
     {"structure_no_lift_3d.yaml", 13, 19, "needs 'lift_direction'",

@@ -216,6 +216,7 @@ class CpuBackend final : public Backend {
     if (ids_.structure_force >= 0) v.structure_force = s.data<Vec<D>>(ids_.structure_force);
     if (ids_.body >= 0) v.body = s.data<std::uint8_t>(ids_.body);
     if (ids_.zone >= 0) v.zone = s.data<std::uint8_t>(ids_.zone);
+    if (ids_.free_slip >= 0) v.free_slip = s.data<std::uint8_t>(ids_.free_slip);
     if (ids_.viscous_velocity >= 0) v.viscous_velocity = s.data<Vec<D>>(ids_.viscous_velocity);
     if (ids_.shifting_velocity >= 0) v.shifting_velocity = s.data<Vec<D>>(ids_.shifting_velocity);
     if (ids_.shear_rate >= 0) v.shear_rate = s.data<Real>(ids_.shear_rate);

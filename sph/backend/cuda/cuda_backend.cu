@@ -357,6 +357,7 @@ class CudaBackend final : public Backend {
     if (ids_.structure_force >= 0) v.structure_force = static_cast<Vec<D>*>(field(ids_.structure_force));
     if (ids_.body >= 0) v.body = static_cast<std::uint8_t*>(field(ids_.body));
     if (ids_.zone >= 0) v.zone = static_cast<std::uint8_t*>(field(ids_.zone));
+    if (ids_.free_slip >= 0) v.free_slip = static_cast<std::uint8_t*>(field(ids_.free_slip));
     if (ids_.viscous_velocity >= 0) v.viscous_velocity = static_cast<Vec<D>*>(field(ids_.viscous_velocity));
     if (ids_.shifting_velocity >= 0) v.shifting_velocity = static_cast<Vec<D>*>(field(ids_.shifting_velocity));
     if (ids_.shear_rate >= 0) v.shear_rate = static_cast<Real*>(field(ids_.shear_rate));
