@@ -9,7 +9,10 @@
 //  - the criterion: exactly the particles whose shear stress passes the threshold split, and with
 //    `where: interface` only those with a fluid neighbour of another material (brute force);
 //  - a full store refuses the surplus mothers, lowest index first served, and overwrites nothing;
-//  - the outcome is bitwise the same for 1 and 2 threads.
+//  - the outcome is bitwise the same for 1 and 2 threads;
+//  - summation density sum_j m_j W(r_ij, (h_i + h_j)/2) on a uniform 2D lattice at rest, before and
+//    after splitting a square block of it (reference: the mother's summation density): exact deep
+//    inside the split block; the blip on its edge, where daughters meet mothers, is printed (open).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -23,6 +26,7 @@
 #include <vector>
 
 #include "sph/backend.hpp"
+#include "sph/kernels.hpp"
 #include "sph/fields.hpp"
 #include "sph/particle_store.hpp"
 #include "sph/splitting.hpp"
@@ -295,6 +299,53 @@ TEST(Splitting, ThreadCountDoesNotChangeBits) {
   ASSERT_EQ(a.n(), b.n());
   for (int f = 0; f < a.s.field_count(); ++f)
     EXPECT_EQ(std::memcmp(a.s.raw(f), b.s.raw(f), a.n() * a.s.field_bytes(f)), 0) << a.s.desc(f).name;
+}
+
+// Summation density at particle i over all particles, pair h the mean (as the passes use).
+double summation_density(const World<2>& w, std::size_t i) {
+  double rho = 0;
+  for (std::size_t j = 0; j < w.n(); ++j) {
+    const double r = std::hypot(double(w.x(i)[0] - w.x(j)[0]), double(w.x(i)[1] - w.x(j)[1]));
+    rho += w.m(j) * double(WendlandC2<2>::w(Real(r), Real(0.5 * (w.h(i) + w.h(j)))));
+  }
+  return rho;
+}
+
+TEST(Splitting, SummationDensityInsideASplitBlockIsTheMothers) {
+  // 40 x 40 lattice at uniform density (h = 2 dx); the 12 x 12 block in its middle splits.
+  constexpr int n = 40;
+  const auto inside = [](const Vec<2>& x) {
+    return std::abs(x[0] - Real(0.2)) < Real(0.06) && std::abs(x[1] - Real(0.2)) < Real(0.06);
+  };
+  World<2> w(n, std::size_t(n * n) * 4, [](const Vec<2>&) { return 1; }, [](std::size_t) { return 500.0; });
+  for (std::size_t i = 0; i < w.n(); ++i) {
+    w.s.data<Real>(w.ids.density)[i] = Real(kRho0);
+    w.s.data<Real>(w.ids.mass)[i] = Real(kRho0 * kDx * kDx);
+    w.s.data<Real>(w.ids.shear_stress)[i] = Real(inside(w.x(i)) ? 500.0 : 0.0);
+  }
+  // Reference: a mother at the block's centre before the split (the lattice sum at h = 2 dx).
+  std::size_t centre = 0;
+  for (std::size_t i = 0; i < w.n(); ++i)
+    if (std::abs(w.x(i)[0] - Real(0.195)) < Real(1e-4) && std::abs(w.x(i)[1] - Real(0.195)) < Real(1e-4)) centre = i;
+  const double rho_mother = summation_density(w, centre);
+  const SplitCounts c = w.be->split(one_rule(150.0, false));
+  ASSERT_EQ(c.splits, 144u);
+  double deep = 0, edge_max = 0;
+  for (std::size_t i = 0; i < w.n(); ++i) {
+    if (w.material(i) != 2) continue;
+    const double dev = std::abs(summation_density(w, i) / rho_mother - 1.0);
+    const double from_edge = 0.06 - std::max(std::abs(double(w.x(i)[0]) - 0.2), std::abs(double(w.x(i)[1]) - 0.2));
+    if (from_edge > 2.0 * 2.0 * kDx) deep = std::max(deep, dev);  // beyond the mothers' support
+    edge_max = std::max(edge_max, dev);
+  }
+  std::printf("summation density after the split: deep daughters within %.3f%%, all daughters within %.2f%%\n",
+              100 * deep, 100 * edge_max);
+  // Daughters among daughters form a lattice of dx/2 with h = dx, the mothers' lattice scaled by
+  // one half, so their summation density is the mothers' (0.000% measured; bound 0.3%).
+  EXPECT_LT(deep, 0.003) << "daughters more than 2h from the block's edge";
+  // Open (transition issue): on the block's edge, where daughters meet mothers of twice their h,
+  // the kernel of the mean h gives up to 15.5% (the mean of both kernels 11%, the daughter's own h
+  // 4.8%, measured by the same sum); the issue asks 2%. Printed above, not asserted yet.
 }
 
 TEST(Splitting, DivideCarryNeedsFloatingPoint) {
