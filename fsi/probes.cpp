@@ -97,6 +97,15 @@ double evaluate(const Scene& scene, const ProbeSpec& probe, const sph::ParticleS
       }
       return std::isfinite(best) ? best + 0.5 * dx : std::nan("");  // no fluid at the station: NaN
     }
+    case ProbeSpec::Type::material_mass: {
+      // Splitting moves mass from one material to another: with transitions the sum over the
+      // materials involved is what stays constant.
+      const int want = material_index(scene, probe.material);
+      double total = 0;
+      for (std::size_t i = 0; i < n; ++i)
+        if (fluid(i) && mat[i] == want) total += double(m[i]);
+      return total;
+    }
   }
   return std::nan("");
 }
@@ -111,6 +120,7 @@ const char* probe_unit(ProbeSpec::Type t) {
     case ProbeSpec::Type::kinetic_energy: return "J";
     case ProbeSpec::Type::fluid_particles: return "1";
     case ProbeSpec::Type::surface_elevation: return "m";
+    case ProbeSpec::Type::material_mass: return "kg";
   }
   return "";
 }

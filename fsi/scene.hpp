@@ -142,10 +142,11 @@ struct ProbeSpec {
     // free-surface elevation at a station [m]: the highest fluid (of `material`) along the vertical
     // `axis` among particles horizontally within dx of `point`, see fsi/probes.cpp
     surface_elevation,
+    material_mass,   // total mass of the fluid of `material` [kg] (per metre of depth in 2D: kg/m)
   };
   std::string name;
   Type type = Type::max_speed;
-  std::string material;  // front_position, surface_elevation: empty = any fluid
+  std::string material;  // front_position, surface_elevation: empty = any fluid; material_mass: required
   int axis = 0;          // front_position: 0 = x, 1 = y, 2 = z; surface_elevation: the vertical
                          // (up is +axis; the reader sets the last axis, y in 2D, z in 3D)
   Vec3d point{0, 0, 0};  // pressure: the point; surface_elevation: the station (its `axis` component unused)

@@ -1030,7 +1030,7 @@ void Reader::read_probes(const Value& v, fsi::Scene& scene) const {
   std::vector<std::string> material_names;
   for (const auto& m : scene.materials) material_names.push_back(m.name);
   const std::vector<std::string> types = {"front_position", "pressure", "max_speed", "kinetic_energy",
-                                          "fluid_particles", "surface_elevation"};
+                                          "fluid_particles", "surface_elevation", "material_mass"};
   std::map<std::string, int> first_line;
   for (const Value& item : list(v)) {
     MapView m(*this, item, {"name", "type", "material", "axis", "point", "at"});
@@ -1056,6 +1056,10 @@ void Reader::read_probes(const Value& v, fsi::Scene& scene) const {
     if (probe.type == fsi::ProbeSpec::Type::front_position) uses = {"material", "axis"};
     if (probe.type == fsi::ProbeSpec::Type::pressure) uses = {"point"};
     if (probe.type == fsi::ProbeSpec::Type::surface_elevation) uses = {"material", "at"};
+    if (probe.type == fsi::ProbeSpec::Type::material_mass) {
+      uses = {"material"};
+      m.need("material");
+    }
     for (const char* key : {"material", "axis", "point", "at"})
       if (m.has(key) && std::find(uses.begin(), uses.end(), key) == uses.end())
         fail(m.key_mark(key), "'" + std::string(key) + "' does not apply to a '" + types[t] + "' probe");

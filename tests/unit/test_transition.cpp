@@ -3,7 +3,8 @@
 // splitting at the debris-water interface where sqrt(J2) > 15 Pa (below tau_y = 20 Pa, so yielded
 // interface particles qualify). Checked after 60 steps, against conservation laws and the rules:
 //  - splits happen, 2^D - 1 = 3 new particles each, none lost (particle count);
-//  - the soil's mass (debris + turbidity) equals the debris mass at the start, 1e-12 relative;
+//  - the soil's mass (debris + turbidity) equals the debris mass at the start, 1e-12 relative, in
+//    the particles and in the material_mass probes;
 //  - every turbidity particle has h = h0/2 and no particle has less (levels: 1);
 //  - the time step follows the daughters' h (below the unsplit run's);
 //  - two runs write the same bits (determinism of the insertion order).
@@ -12,6 +13,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <string>
+#include <vector>
 
 #include "fsi/scene.hpp"
 #include "fsi/simulation.hpp"
@@ -60,6 +63,13 @@ fsi::Scene collapse_scene(bool with_transition) {
   w.box.min = {0.2, 0, 0};
   w.box.max = {0.6, 0.2, 0};
   s.fluids = {d, w};
+  for (const char* m : {"debris", "turbidity"}) {
+    fsi::ProbeSpec probe;
+    probe.name = std::string(m) + "_mass";
+    probe.type = fsi::ProbeSpec::Type::material_mass;
+    probe.material = m;
+    s.probes.push_back(probe);
+  }
   if (with_transition) {
     fsi::TransitionSpec t;
     t.from = "debris";
@@ -107,6 +117,7 @@ TEST(Transition, CollapsingDebrisSplitsAtTheInterfaceConservingSoilMass) {
   plain.start();
   const std::size_t n0 = sim.store().size();
   const Soil before = soil(sim);
+  const std::vector<double> probes0 = sim.probe_values();  // debris_mass, turbidity_mass [kg/m]
   ASSERT_EQ(before.turbidity, 0u);
   EXPECT_EQ(sim.store().capacity(), std::size_t(std::ceil(3.0 * double(n0)))) << "capacity: factor 3";
   for (int k = 0; k < 60; ++k) {
@@ -122,6 +133,11 @@ TEST(Transition, CollapsingDebrisSplitsAtTheInterfaceConservingSoilMass) {
   EXPECT_EQ(sim.store().size(), n0 + c.daughters) << "particles: start + daughters";
   EXPECT_EQ(after.turbidity, 4 * c.splits) << "every daughter is turbidity";
   EXPECT_NEAR(after.mass, before.mass, 1e-12 * before.mass) << "soil mass (debris + turbidity)";
+  const std::vector<double> probes = sim.probe_values();
+  EXPECT_EQ(probes0[1], 0.0) << "no turbidity at the start (material_mass probe)";
+  EXPECT_NEAR(probes0[0], before.mass, 1e-12 * before.mass) << "debris probe = debris mass at the start";
+  EXPECT_NEAR(probes[0] + probes[1], before.mass, 1e-12 * before.mass) << "material_mass probes: soil mass kept";
+  EXPECT_GT(probes[1], 0.0) << "turbidity has mass once particles split";
   const double h0 = 2.0 * kDx;
   EXPECT_FLOAT_EQ(float(after.turbidity_h_max), float(0.5 * h0)) << "daughters have h0/2";
   EXPECT_FLOAT_EQ(float(after.h_min), float(0.5 * h0)) << "one level: no particle below h0/2";
