@@ -11,12 +11,6 @@
 namespace turbid::fsi {
 namespace {
 
-int material_index(const Scene& scene, const std::string& name) {
-  for (std::size_t m = 0; m < scene.materials.size(); ++m)
-    if (scene.materials[m].name == name) return int(m);
-  return -1;
-}
-
 template <int D>
 double evaluate(const Scene& scene, const ProbeSpec& probe, const sph::ParticleStore& s, const sph::FieldIds& ids,
                 const sph::PhysicsParams& params) {

@@ -223,4 +223,11 @@ struct Scene {
   std::array<bool, 3> periodic{false, false, false};
 };
 
+// Index of the material named `name` in scene.materials, or -1.
+inline int material_index(const Scene& scene, const std::string& name) {
+  for (std::size_t m = 0; m < scene.materials.size(); ++m)
+    if (scene.materials[m].name == name) return int(m);
+  return -1;
+}
+
 }  // namespace turbid::fsi

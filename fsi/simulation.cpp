@@ -467,9 +467,7 @@ sph::PhysicsParams physics_params(const Scene& scene) {
       z.lo[k2] = sph::Real(ob.box.min[k2]);
       z.hi[k2] = sph::Real(ob.box.max[k2]);
     }
-    z.material = 0;
-    for (std::size_t m = 0; m < scene.materials.size(); ++m)
-      if (scene.materials[m].name == ob.material) z.material = std::uint8_t(m);
+    z.material = std::uint8_t(std::max(0, material_index(scene, ob.material)));
   }
   return p;
 }
@@ -512,9 +510,9 @@ sph::SplitParams split_params(const Scene& scene) {
     throw std::invalid_argument("at most " + std::to_string(sph::kMaxSplitRules) + " transitions are supported");
   const double h0 = scene.smoothing_ratio * scene.particle_spacing;
   const auto index = [&](const std::string& name) {
-    for (std::size_t m = 0; m < scene.materials.size(); ++m)
-      if (scene.materials[m].name == name) return std::uint8_t(m);
-    throw std::invalid_argument("transition names an unknown material '" + name + "'");
+    const int m = material_index(scene, name);
+    if (m < 0) throw std::invalid_argument("transition names an unknown material '" + name + "'");
+    return std::uint8_t(m);
   };
   for (const auto& t : scene.transitions) {
     sph::SplitRule& r = sp.rules[sp.rule_count++];
@@ -558,8 +556,7 @@ void Simulation::build_particles() {
   summary_.particles_per_material.assign(s.materials.size(), 0);
 
   auto material_of = [&](const std::string& name, const SourceLocation& where) {
-    for (std::size_t m = 0; m < s.materials.size(); ++m)
-      if (s.materials[m].name == name) return std::uint8_t(m);
+    if (const int m = material_index(s, name); m >= 0) return std::uint8_t(m);
     std::ostringstream os;
     os << where.file << ":" << where.line << ":" << where.column << ": error: unknown material '" << name << "'";
     throw std::invalid_argument(os.str());
