@@ -53,8 +53,12 @@ TEST(FluidRegions, PolygonBlockCutOutOfTheWaterAroundIt) {
   EXPECT_EQ(per[0] + per[1], std::size_t(10000)) << "earlier block wins; every lattice point once";
 }
 
-TEST(FluidRegions, LayeredStartCarriesTheWeightOfAllFluidAbove) {
-  fsi::Simulation sim(slide_in_water(), {"cpu", 1});
+// Water particles of the column x = 0.505 below the slide (height <= 0.2 m along the vertical,
+// the last axis): each must start at the density of the weight of all fluid above it, water up to
+// the slide's hypotenuse (height 0.8 - x), the slide up to 0.6 m, water again up to 1 m; dx / 8
+// integration steps put it within rho g dx / 8 of that weight. Returns how many were checked.
+int check_weight_above_column(const fsi::Simulation& sim) {
+  const int d = sim.scene().dimensions;
   const auto& st = sim.store();
   const auto* x = static_cast<const float*>(st.raw(sim.fields().position));
   const auto* rho = st.data<float>(sim.fields().density);
@@ -64,21 +68,23 @@ TEST(FluidRegions, LayeredStartCarriesTheWeightOfAllFluidAbove) {
   int checked = 0;
   for (std::size_t i = 0; i < st.size(); ++i) {
     if (kind[i] != 0 || mat[i] != 1) continue;
-    const double px = x[2 * i], py = x[2 * i + 1];
-    if (std::abs(px - 0.505) > 1e-4 || py > 0.2) continue;  // water under the slide, column x = 0.505
-    // Above it: water up to the slide's hypotenuse y = 0.8 - x (from (0.2, 0.6) to (0.6, 0.2)), the
-    // slide up to y = 0.6, water again up to y = 1.
+    const double px = x[std::size_t(d) * i], height = x[std::size_t(d) * i + std::size_t(d - 1)];
+    if (std::abs(px - 0.505) > 1e-4 || height > 0.2) continue;
     const double slide_bottom = 0.8 - px;
     const double slide_thickness = 0.6 - slide_bottom;
-    const double water_thickness = (1.0 - py) - slide_thickness;
+    const double water_thickness = (1.0 - height) - slide_thickness;
     const double p = 9.81 * (1000.0 * water_thickness + 1950.0 * slide_thickness);
-    const double expected = eos_water.density_at_gauge(p);
-    // dx / 8 integration steps: within rho g dx / 8 of the exact weight.
-    EXPECT_NEAR(rho[i], expected, (1950.0 * 9.81 * kDx / 8) / (double(eos_water.stiffness) * 7) * 1000.0 + 1e-3)
-        << "water particle at y = " << py;
+    EXPECT_NEAR(rho[i], eos_water.density_at_gauge(p),
+                (1950.0 * 9.81 * kDx / 8) / (double(eos_water.stiffness) * 7) * 1000.0 + 1e-3)
+        << "water particle at height " << height;
     ++checked;
   }
-  EXPECT_EQ(checked, 20) << "the column below the slide";
+  return checked;
+}
+
+TEST(FluidRegions, LayeredStartCarriesTheWeightOfAllFluidAbove) {
+  fsi::Simulation sim(slide_in_water(), {"cpu", 1});
+  EXPECT_EQ(check_weight_above_column(sim), 20) << "the column below the slide";
 }
 
 // The slide-in-water scene of the 2D tests, extruded: the same x-z cross-section (the triangle in the
@@ -127,28 +133,7 @@ TEST(FluidRegions, ExtrudedLayeredStartCarriesTheWeightOfAllFluidAbove) {
   // The 2D layered-start test in 3D: the height axis is z (gravity's), the layers those of the
   // extruded section, so every row across y has the 2D column's densities.
   fsi::Simulation sim(slide_in_water_3d(0.05), {"cpu", 1});
-  const auto& st = sim.store();
-  const auto* x = static_cast<const float*>(st.raw(sim.fields().position));
-  const auto* rho = st.data<float>(sim.fields().density);
-  const auto* kind = st.data<std::uint8_t>(sim.fields().kind);
-  const auto* mat = st.data<std::uint8_t>(sim.fields().material);
-  const auto& eos_water = sim.params().materials[1].eos;
-  int checked = 0;
-  for (std::size_t i = 0; i < st.size(); ++i) {
-    if (kind[i] != 0 || mat[i] != 1) continue;
-    const double px = x[3 * i], pz = x[3 * i + 2];
-    if (std::abs(px - 0.505) > 1e-4 || pz > 0.2) continue;  // water under the slide, column x = 0.505
-    const double slide_bottom = 0.8 - px;                    // the hypotenuse z = 0.8 - x
-    const double slide_thickness = 0.6 - slide_bottom;
-    const double water_thickness = (1.0 - pz) - slide_thickness;
-    const double p = 9.81 * (1000.0 * water_thickness + 1950.0 * slide_thickness);
-    // dx / 8 integration steps: within rho g dx / 8 of the exact weight (as in 2D).
-    EXPECT_NEAR(rho[i], eos_water.density_at_gauge(p),
-                (1950.0 * 9.81 * kDx / 8) / (double(eos_water.stiffness) * 7) * 1000.0 + 1e-3)
-        << "water particle at z = " << pz;
-    ++checked;
-  }
-  EXPECT_EQ(checked, 20 * 5) << "the column below the slide on each of the 5 rows";
+  EXPECT_EQ(check_weight_above_column(sim), 20 * 5) << "the column below the slide on each of the 5 rows";
 }
 
 TEST(FluidRegions, ExtrudedPolylineWallRepeatsItsLayersAcrossTheSpan) {
