@@ -14,7 +14,7 @@ struct SplitRule {
   std::uint8_t from = 0;            // material whose particles split
   std::uint8_t to = 0;              // material of the daughters (same reference density)
   Real threshold = 0;               // effective shear stress sqrt(J2(tau)) above which a particle splits [Pa]
-  bool interface_only = true;       // only particles with a fluid neighbour of another material
+  bool interface_only = true;       // only particles with a fluid neighbour of a third material (not from, not to)
   Real min_smoothing_length = 0;    // only particles with h above this split (bounds the levels) [m]
 };
 

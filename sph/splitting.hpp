@@ -51,7 +51,9 @@ TURBID_HD inline Real split_edge(Real mass, Real density) {
 
 // Step (1) for every particle: new_slots[i] = 2^D - 1 if i meets a rule, else 0; rule_of[i] the
 // rule's index (or -1). The criterion reads the effective shear stress of the last force pass.
-// `where: interface` asks for a fluid neighbour of another material within the pair's support.
+// `where: interface` asks for a fluid neighbour of a third material (neither the rule's `from` nor its
+// `to`: the ambient fluid) within the pair's support, so the daughters next to a mother do not make
+// her an interface particle and the split does not cascade through the slide.
 template <int D, class K, bool UniformH>
 struct SplitFlagPass {
   ParticleView<D> P;
@@ -77,11 +79,12 @@ struct SplitFlagPass {
     }
     if (rule < 0) return;
     if (sp.rules[rule].interface_only) {
+      const std::uint8_t to = sp.rules[rule].to;
       bool other = false;
       for_each_neighbour<D>(P, G, NeighbourList{}, prm, i, P.position[i], [&](std::uint32_t j, const Vec<D>&, Real r2) {
         const Real h = pair_h<D, K>(P, prm, UniformH, h_i, j);
         if (!UniformH && r2 >= Real(4) * h * h) return;
-        other = other || (P.kind[j] == std::uint8_t(Kind::fluid) && P.material[j] != mat);
+        other = other || (P.kind[j] == std::uint8_t(Kind::fluid) && P.material[j] != mat && P.material[j] != to);
       });
       if (!other) return;
     }
