@@ -193,8 +193,11 @@ class CpuBackend final : public Backend {
   }
 
   double max_h_ratio() const {
-    // Largest h present relative to the initial h; splitting only halves h, so 1 for now.
-    return 1.0;
+    // Largest h present relative to the initial h (PhysicsParams::max_smoothing_length): the cells
+    // must be at least the largest pair support 2 h_max, or pairs beyond one cell are never seen.
+    // Splitting only halves h (ratio 1), but a store may carry h above the lattice's.
+    const double h0 = params_.smoothing_length, h_max = params_.max_smoothing_length;
+    return h_max > h0 ? h_max / h0 : 1.0;
   }
 
   template <int D>
