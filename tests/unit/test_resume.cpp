@@ -1,8 +1,13 @@
 // Checkpoint/resume: a run resumed from a checkpoint ends bit-identical to one that never stopped
 // (reference: the CPU backend is deterministic — gather sums in a fixed neighbour order, stable
 // counting sort, fixed-order reductions — so the same state must give the same bits).
+// Through splitting events too (debris -> turbidity): the checkpoint holds a grown particle count
+// and daughters of half h; the resumed store keeps the scene's reserved capacity, the split totals
+// and the daughters' time-step limit, so later splits and steps are the same as without the stop.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -47,48 +52,120 @@ turbid::tools::RunRequest request(const fs::path& scene, const fs::path& out) {
   return r;
 }
 
+// A Bingham debris column (tau_y = 20 Pa) collapsing into water in a closed tank (the scene of
+// test_transition.cpp at twice the spacing), splitting into turbidity at the wet face where
+// sqrt(J2) > 20.1 Pa: just above the yield stress, so mothers split one by one as the face yields
+// (below tau_y nearly all splits come in the first steps, from the start-up transient).
+const char* kSplittingScene = R"(name: resume_split_check
+dimensions: 2
+resolution: {particle_spacing: 0.02, smoothing_ratio: 2.0}
+time: {end: 0.06, cfl: 0.2}
+gravity: [0, -9.81]
+numerics: {viscosity: {type: laminar}}
+materials:
+  water: {model: newtonian, density: 1000, viscosity: 1.0e-3, sound_speed: 20}
+  debris: {model: bingham, density: 1950, viscosity: 0.1, yield_stress: 20, papanastasiou_exponent: 100,
+           sound_speed: 20}
+  turbidity: {model: newtonian, density: 1950, viscosity: 1.0e-3, sound_speed: 20}
+walls:
+  - box: {min: [0, 0], max: [0.6, 0.3]}
+fluids:
+  - {material: debris, box: {min: [0, 0], max: [0.2, 0.2]}}
+  - {material: water, box: {min: [0.2, 0], max: [0.6, 0.2]}}
+transitions:
+  - {from: debris, to: turbidity, when: {effective_shear_stress_above: 20.1}, where: interface}
+capacity: {factor: 3.0}
+probes:
+  - {name: debris_mass, type: material_mass, material: debris}
+  - {name: turbidity_mass, type: material_mass, material: turbidity}
+  - {name: vmax, type: max_speed}
+output: {every: 0.01, vtk: true}
+)";
+
+nlohmann::json checkpoint_state(const fs::path& run_dir) {
+  std::ifstream in(run_dir / "checkpoint" / "checkpoint.json");
+  return nlohmann::json::parse(in).at("state");
+}
+
+struct ResumeRuns {
+  nlohmann::json full, part, resumed;
+  nlohmann::json checkpoint_before_resume;  // the state the resumed run started from
+};
+
 }  // namespace
 
-void check_resume(const std::string& scene_text) {
+// Runs the scene to 0.06 s without stopping, and again stopped at 0.035 s (checkpoints every
+// 0.02 s) and resumed from the checkpoint at 0.02 s; both runs must write the same bytes.
+ResumeRuns check_resume(const std::string& scene_text) {
+  ResumeRuns r;
   const fs::path dir = fs::temp_directory_path() / ("turbid_resume_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path scene = dir / "scene.yaml";
   std::ofstream(scene) << scene_text;
 
-  // Uninterrupted run to 0.06 s.
-  const auto full = turbid::tools::run_scene(request(scene, dir / "full"));
-  ASSERT_EQ(full.at("status"), "completed");
+  // Uninterrupted run to 0.06 s, with the same checkpoints as the interrupted one (they change
+  // nothing in the run) so that the last checkpoints of both can be compared field by field.
+  auto uninterrupted = request(scene, dir / "full");
+  uninterrupted.checkpoint_every = 0.02;
+  r.full = turbid::tools::run_scene(uninterrupted);
+  EXPECT_EQ(r.full.at("status"), "completed");
 
   // Interrupted run: stops at 0.035 s with a checkpoint taken at 0.02 s, then resumes to 0.06 s.
   auto first = request(scene, dir / "split");
   first.end_time = 0.035;
   first.checkpoint_every = 0.02;
-  const auto part = turbid::tools::run_scene(first);
-  ASSERT_EQ(part.at("status"), "completed");
+  r.part = turbid::tools::run_scene(first);
+  EXPECT_EQ(r.part.at("status"), "completed");
+  r.checkpoint_before_resume = checkpoint_state(dir / "split");
   turbid::tools::RunRequest again;
   again.resume = dir / "split";
   again.backend = "cpu";
   again.progress = false;
   again.end_time = 0.06;
-  const auto resumed = turbid::tools::run_scene(again);
-  ASSERT_EQ(resumed.at("status"), "completed");
+  again.checkpoint_every = 0.02;
+  r.resumed = turbid::tools::run_scene(again);
+  EXPECT_EQ(r.resumed.at("status"), "completed");
 
-  EXPECT_EQ(full.at("steps"), resumed.at("steps"));
-  EXPECT_EQ(full.at("simulated_time").get<double>(), resumed.at("simulated_time").get<double>());
+  EXPECT_EQ(r.full.at("steps"), r.resumed.at("steps"));
+  EXPECT_EQ(r.full.at("simulated_time").get<double>(), r.resumed.at("simulated_time").get<double>());
+  // run.json: counts, capacity, split totals, masses and momenta (exact: same bits, same sums).
+  for (const char* key : {"particles", "particles_end", "removed_particles", "capacity", "splits", "daughters_created",
+                          "splits_refused", "fluid_mass_start", "fluid_mass_end", "fluid_momentum_start",
+                          "fluid_momentum_end", "materials"}) {
+    EXPECT_EQ(r.full.contains(key), r.resumed.contains(key)) << key;
+    if (r.full.contains(key)) EXPECT_EQ(r.full.at(key), r.resumed.at(key)) << "run.json '" << key << "' after resume";
+  }
   // Every frame and every probe row must match byte for byte.
   int frames = 0;
   for (const auto& e : fs::directory_iterator(dir / "full")) {
     if (e.path().extension() != ".vtp") continue;
     const fs::path twin = dir / "split" / e.path().filename();
-    ASSERT_TRUE(fs::exists(twin)) << twin;
-    EXPECT_EQ(slurp(e.path()), slurp(twin)) << e.path().filename() << " differs after resume";
+    EXPECT_TRUE(fs::exists(twin)) << twin;
+    EXPECT_TRUE(slurp(e.path()) == slurp(twin)) << e.path().filename() << " differs after resume";
     ++frames;
   }
   EXPECT_GE(frames, 6);
   EXPECT_EQ(slurp(dir / "full" / "probes.csv"), slurp(dir / "split" / "probes.csv"));
   EXPECT_EQ(slurp(dir / "full" / "particles.pvd"), slurp(dir / "split" / "particles.pvd"));
+  // The last checkpoint (after the resume point): every checkpointed field, including those the
+  // frames leave out (mass, smoothing length, acceleration), and the saved state but the wall time.
+  auto state_full = checkpoint_state(dir / "full");
+  auto state_resumed = checkpoint_state(dir / "split");
+  EXPECT_GT(state_resumed.at("time").get<double>(), 0.035) << "a checkpoint written after the resume";
+  state_full.erase("wall_seconds");
+  state_resumed.erase("wall_seconds");
+  EXPECT_EQ(state_full, state_resumed);
+  int fields = 0;
+  for (const auto& e : fs::directory_iterator(dir / "full" / "checkpoint")) {
+    if (e.path().extension() != ".bin") continue;
+    EXPECT_TRUE(slurp(e.path()) == slurp(dir / "split" / "checkpoint" / e.path().filename()))
+        << "checkpointed field " << e.path().filename() << " differs after resume";
+    ++fields;
+  }
+  EXPECT_GE(fields, 8);
   fs::remove_all(dir);
+  return r;
 }
 
 TEST(CheckpointResume, ResumedRunIsBitIdenticalToUninterruptedRun) { check_resume(kScene); }
@@ -97,4 +174,29 @@ TEST(CheckpointResume, ResumedRunIsBitIdenticalToUninterruptedRun) { check_resum
 // the checkpoint must therefore hold (like the acceleration).
 TEST(CheckpointResume, ResumedRunWithShiftingIsBitIdentical) {
   check_resume(std::string(kScene) + "numerics: {shifting: {coefficient: 2.0}}\n");
+}
+
+// Splits before the checkpoint (0.02 s), between it and the stop (0.035 s) and after the resume:
+// the checkpoint holds more particles than the scene builds, some with h/2, and the resumed run
+// must go on splitting exactly as the uninterrupted one (same totals, same capacity).
+TEST(CheckpointResume, ResumedRunThroughSplittingIsBitIdentical) {
+  const ResumeRuns r = check_resume(kSplittingScene);
+  const std::size_t at_checkpoint = r.checkpoint_before_resume.at("splits").get<std::size_t>();
+  const std::size_t at_stop = r.part.at("splits").get<std::size_t>();
+  const std::size_t at_end = r.full.at("splits").get<std::size_t>();
+  std::printf("splits: %zu by the checkpoint (t = %.4f s), %zu by the stop, %zu by the end; %zu particles at the end\n",
+              at_checkpoint, r.checkpoint_before_resume.at("time").get<double>(), at_stop, at_end,
+              r.full.at("particles_end").get<std::size_t>());
+  EXPECT_GT(at_checkpoint, 0u) << "the checkpoint must hold daughters";
+  EXPECT_GT(at_stop, at_checkpoint) << "splits between the checkpoint and the stop (redone after the resume)";
+  EXPECT_GT(at_end, at_stop) << "splits after the stop";
+  EXPECT_EQ(r.checkpoint_before_resume.at("smallest_smoothing_length").get<double>(), double(0.5f * 0.04f))
+      << "daughters' h, h0/2 = 0.02 m";
+  EXPECT_EQ(r.full.at("splits_refused").get<std::size_t>(), 0u);
+  EXPECT_EQ(r.resumed.at("daughters_created").get<std::size_t>(), 3 * at_end);
+  EXPECT_EQ(r.resumed.at("particles_end").get<std::size_t>(),
+            r.resumed.at("particles").get<std::size_t>() + 3 * at_end) << "particles: start + daughters";
+  // The store reserves the scene's capacity (factor 3 of the particles built), not the count saved.
+  EXPECT_EQ(r.resumed.at("capacity").get<std::size_t>(),
+            std::size_t(std::ceil(3.0 * double(r.resumed.at("particles").get<std::size_t>()))));
 }

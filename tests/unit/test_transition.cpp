@@ -8,9 +8,15 @@
 //    the particles and in the material_mass probes;
 //  - every turbidity particle has h = h0/2 and no particle has less (levels: 1);
 //  - the time step follows the daughters' h (below the unsplit run's);
-//  - two runs write the same bits (determinism of the insertion order).
+//  - two runs write the same bits (determinism of the insertion order);
+//  - inside a run (mixed h, walls, water), the split the time loop performs (backend split, then
+//    the new grid and forces, as Solver::split does) keeps the fluid's mass, linear momentum,
+//    kinetic energy and centre of mass: 1e-12 relative with double accumulation (daughters'
+//    m/2^D is exact, velocities are copied; only the order of the sums differs), the centre to the
+//    rounding of the float positions.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -165,6 +171,74 @@ TEST(Transition, TwoRunsWriteTheSameBits) {
   for (int f = 0; f < a.store().field_count(); ++f)
     EXPECT_EQ(std::memcmp(a.store().raw(f), b.store().raw(f), a.store().size() * a.store().field_bytes(f)), 0)
         << a.store().desc(f).name;
+}
+
+// Totals of the fluid in double, index order: mass [kg/m], momentum [kg m/s per m], kinetic
+// energy [J/m], mass-weighted position [kg]; scales for the tolerances.
+struct Totals {
+  double mass = 0, px = 0, py = 0, energy = 0, mx = 0, my = 0;
+  double momentum_scale = 0, max_coordinate = 0;
+  std::size_t fluid = 0;
+};
+
+Totals totals(fsi::Simulation& sim) {
+  sim.sync_to_host();
+  const auto& st = sim.store();
+  const auto& ids = sim.fields();
+  const auto* m = st.data<float>(ids.mass);
+  const auto* v = st.data<float>(ids.velocity);
+  const auto* x = st.data<float>(ids.position);
+  const auto* kind = st.data<std::uint8_t>(ids.kind);
+  Totals t;
+  for (std::size_t i = 0; i < st.size(); ++i) {
+    if (kind[i] != 0) continue;
+    ++t.fluid;
+    const double mi = m[i], vx = v[2 * i], vy = v[2 * i + 1];
+    t.mass += mi;
+    t.px += mi * vx;
+    t.py += mi * vy;
+    t.energy += 0.5 * mi * (vx * vx + vy * vy);
+    t.mx += mi * x[2 * i];
+    t.my += mi * x[2 * i + 1];
+    t.momentum_scale += mi * std::hypot(vx, vy);
+    t.max_coordinate = std::max({t.max_coordinate, std::fabs(double(x[2 * i])), std::fabs(double(x[2 * i + 1]))});
+  }
+  return t;
+}
+
+TEST(Transition, SplitInsideARunConservesMassMomentumEnergyAndCentre) {
+  const fsi::Scene scene = collapse_scene(true);
+  fsi::Simulation sim(scene, {"cpu", 1});
+  sim.start();
+  for (int k = 0; k < 30; ++k) sim.step();
+  ASSERT_GT(sim.split_totals().splits, 0u) << "daughters (h/2) already in the flow";
+  // Every debris particle left qualifies now (threshold below zero, anywhere): a large split of a
+  // moving, mixed-h state next to walls and water.
+  sph::SplitParams rules = fsi::split_params(scene);
+  rules.rules[0].threshold = -1;
+  rules.rules[0].interface_only = false;
+  const Totals before = totals(sim);
+  const sph::SplitCounts c = sim.backend().split(rules);
+  EXPECT_EQ(sim.backend().update_neighbours(), 0u) << "no particle lost";
+  sim.backend().compute_forces();
+  const Totals after = totals(sim);
+  ASSERT_GT(c.splits, 100u);
+  EXPECT_EQ(c.refused, 0u);
+  EXPECT_EQ(after.fluid, before.fluid + 3 * c.splits);
+  const double rel = 1e-12;
+  EXPECT_NEAR(after.mass, before.mass, rel * before.mass) << "mass";
+  EXPECT_NEAR(after.px, before.px, rel * before.momentum_scale) << "momentum x";
+  EXPECT_NEAR(after.py, before.py, rel * before.momentum_scale) << "momentum y";
+  EXPECT_NEAR(after.energy, before.energy, rel * before.energy) << "kinetic energy";
+  // Daughters sit symmetrically about their mother, at float positions: half an ulp of the
+  // largest coordinate each, times the mass.
+  const double ulp = std::ldexp(before.max_coordinate, -23);
+  EXPECT_NEAR(after.mx, before.mx, 0.5 * ulp * before.mass) << "centre of mass x";
+  EXPECT_NEAR(after.my, before.my, 0.5 * ulp * before.mass) << "centre of mass y";
+  std::printf("split in a run: %zu mothers; momentum (%.6g, %.6g) -> change (%.3g, %.3g) kg m/s per m, "
+              "energy change %.3g relative\n",
+              c.splits, before.px, before.py, after.px - before.px, after.py - before.py,
+              (after.energy - before.energy) / before.energy);
 }
 
 }  // namespace
