@@ -17,8 +17,11 @@
 // or block scheduling; (4) each accepted mother writes daughter 0 into her own slot and daughters
 // 1..2^D-1 into hers, every registered field carried by its Carry rule.
 #pragma once
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
+#include <limits>
 
 #include "sph/config.hpp"
 #include "sph/passes.hpp"
@@ -41,12 +44,45 @@ TURBID_HD inline Vec<D> daughter_offset(int k, Real edge) {
   return o;
 }
 
-// Edge a = V^(1/D) of the cube a particle of mass m and density rho stands for [m].
+// The cube root of a positive normal float, correctly rounded (to nearest), so that the CPU and
+// the GPU place 3D daughters on the same bits: libm's cbrtf is not correctly rounded (glibc 2.36
+// differs from the correctly rounded root in about 1 float in 10 by one ulp; CUDA's cbrtf is
+// documented within 1 ulp), and the two libraries round differently. The double cube root gives a
+// candidate within one float ulp; the midpoints to its neighbours then decide exactly: a midpoint
+// m has 25 significant bits, so m*m is exact and fma(m*m, m, -v) has the exact sign of m^3 - v
+// (never zero: a 24-bit v is not the cube of a 25-bit m). Square roots need no such care: sqrt is
+// correctly rounded on both backends.
+TURBID_HD inline float cube_root_rn(float v) {
+  if (!(v >= std::numeric_limits<float>::min() && v <= std::numeric_limits<float>::max()))
+    return float(std::cbrt(double(v)));  // 0, subnormal, negative, inf, NaN: not met by a volume
+  const auto step = [](float x, int by) {
+    std::uint32_t b;
+    std::memcpy(&b, &x, sizeof b);
+    b = std::uint32_t(std::int64_t(b) + by);
+    std::memcpy(&x, &b, sizeof b);
+    return x;
+  };
+  const auto cube_minus_v = [v](double m) {
+    const double m2 = m * m;
+    return std::fma(m2, m, -double(v));
+  };
+  float c = float(std::cbrt(double(v)));
+  for (int pass = 0; pass < 2; ++pass) {
+    const float up = step(c, +1), down = step(c, -1);
+    if (cube_minus_v(0.5 * (double(c) + double(up))) < 0.0) c = up;
+    else if (cube_minus_v(0.5 * (double(c) + double(down))) > 0.0) c = down;
+    else break;
+  }
+  return c;
+}
+
+// Edge a = V^(1/D) of the cube a particle of mass m and density rho stands for [m]. Both roots are
+// correctly rounded, so every backend gets the same bits.
 template <int D>
 TURBID_HD inline Real split_edge(Real mass, Real density) {
   const Real volume = mass / density;
   if constexpr (D == 2) return std::sqrt(volume);
-  else return std::cbrt(volume);
+  else return cube_root_rn(volume);
 }
 
 // Step (1) for every particle: new_slots[i] = 2^D - 1 if i meets a rule, else 0; rule_of[i] the
