@@ -267,6 +267,8 @@ struct SplitWritePass {
     for (int k = 0; k < kD; ++k) {
       const std::size_t slot = k == 0 ? i : base + std::size_t(k - 1);
       fields.divide(slot, kD);
+      // +-a/4 is exact (a power-of-two scaling), so where a compiler fuses it with the addition
+      // (nvcc does) the position has the same bits.
       P.position[slot] = periodic.wrap(x0 + daughter_offset<D>(k, edge));
       P.smoothing_length[slot] = Real(0.5) * h;
       P.material[slot] = rule.to;
