@@ -134,25 +134,4 @@ std::size_t ParticleStore::compact(const std::uint8_t* keep) {
   return removed;
 }
 
-void ParticleStore::copy_particle(std::size_t from, std::size_t to) {
-  for (auto& f : fields_) {
-    const std::size_t fb = scalar_size(f.desc.type) * std::size_t(f.desc.components);
-    std::memcpy(f.data.get() + to * fb, f.data.get() + from * fb, fb);
-  }
-}
-
-void ParticleStore::divide_shared(std::size_t i, int shares) {
-  for (auto& f : fields_) {
-    if (f.desc.carry != Carry::divide) continue;
-    const std::size_t c = std::size_t(f.desc.components);
-    if (f.desc.type == ScalarType::f32) {
-      float* v = reinterpret_cast<float*>(f.data.get()) + i * c;
-      for (std::size_t k = 0; k < c; ++k) v[k] /= float(shares);
-    } else if (f.desc.type == ScalarType::f64) {
-      double* v = reinterpret_cast<double*>(f.data.get()) + i * c;
-      for (std::size_t k = 0; k < c; ++k) v[k] /= double(shares);
-    }
-  }
-}
-
 }  // namespace turbid::sph

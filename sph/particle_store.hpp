@@ -17,7 +17,8 @@ enum class ScalarType : std::uint8_t { f32, f64, i32, u32, u8 };
 std::size_t scalar_size(ScalarType t);
 const char* scalar_name(ScalarType t);
 
-// How a field is carried from a mother particle to its daughters when a particle splits.
+// How a field is carried from a mother particle to its daughters when a particle splits (applied by
+// SplitFieldTable in sph/splitting.hpp, the same on every backend).
 enum class Carry : std::uint8_t {
   copy,       // daughters take the mother's value (velocity, density, material)
   divide,     // daughters share the mother's value equally (mass)
@@ -72,13 +73,6 @@ class ParticleStore {
   void permute(const std::uint32_t* order);
   // Keeps particles whose keep[i] != 0, in their order; returns how many were removed.
   std::size_t compact(const std::uint8_t* keep);
-
-  // Splitting (sph/splitting.hpp). Particle `to` becomes a copy of particle `from` in every field;
-  // safe to call concurrently for distinct `to`.
-  void copy_particle(std::size_t from, std::size_t to);
-  // Divides particle i's value of every floating-point field that carries by Carry::divide by
-  // `shares` (the daughters that share the mother's value).
-  void divide_shared(std::size_t i, int shares);
 
  private:
   struct Field {

@@ -17,10 +17,16 @@
 // or block scheduling; (4) each accepted mother writes daughter 0 into her own slot and daughters
 // 1..2^D-1 into hers, every registered field carried by its Carry rule.
 #pragma once
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <string>
 
 #include "sph/config.hpp"
+#include "sph/particle_store.hpp"
 #include "sph/passes.hpp"
 #include "sph/split_params.hpp"
 #include "sph/vec.hpp"
@@ -41,12 +47,45 @@ TURBID_HD inline Vec<D> daughter_offset(int k, Real edge) {
   return o;
 }
 
-// Edge a = V^(1/D) of the cube a particle of mass m and density rho stands for [m].
+// The cube root of a positive normal float, correctly rounded (to nearest), so that the CPU and
+// the GPU place 3D daughters on the same bits: libm's cbrtf is not correctly rounded (glibc 2.36
+// differs from the correctly rounded root in about 1 float in 10 by one ulp; CUDA's cbrtf is
+// documented within 1 ulp), and the two libraries round differently. The double cube root gives a
+// candidate within one float ulp; the midpoints to its neighbours then decide exactly: a midpoint
+// m has 25 significant bits, so m*m is exact and fma(m*m, m, -v) has the exact sign of m^3 - v
+// (never zero: a 24-bit v is not the cube of a 25-bit m). Square roots need no such care: sqrt is
+// correctly rounded on both backends.
+TURBID_HD inline float cube_root_rn(float v) {
+  if (!(v >= std::numeric_limits<float>::min() && v <= std::numeric_limits<float>::max()))
+    return float(std::cbrt(double(v)));  // 0, subnormal, negative, inf, NaN: not met by a volume
+  const auto step = [](float x, int by) {
+    std::uint32_t b;
+    std::memcpy(&b, &x, sizeof b);
+    b = std::uint32_t(std::int64_t(b) + by);
+    std::memcpy(&x, &b, sizeof b);
+    return x;
+  };
+  const auto cube_minus_v = [v](double m) {
+    const double m2 = m * m;
+    return std::fma(m2, m, -double(v));
+  };
+  float c = float(std::cbrt(double(v)));
+  for (int pass = 0; pass < 2; ++pass) {
+    const float up = step(c, +1), down = step(c, -1);
+    if (cube_minus_v(0.5 * (double(c) + double(up))) < 0.0) c = up;
+    else if (cube_minus_v(0.5 * (double(c) + double(down))) > 0.0) c = down;
+    else break;
+  }
+  return c;
+}
+
+// Edge a = V^(1/D) of the cube a particle of mass m and density rho stands for [m]. Both roots are
+// correctly rounded, so every backend gets the same bits.
 template <int D>
 TURBID_HD inline Real split_edge(Real mass, Real density) {
   const Real volume = mass / density;
   if constexpr (D == 2) return std::sqrt(volume);
-  else return std::cbrt(volume);
+  else return cube_root_rn(volume);
 }
 
 // Step (1) for every particle: new_slots[i] = 2^D - 1 if i meets a rule, else 0; rule_of[i] the
@@ -90,6 +129,151 @@ struct SplitFlagPass {
     }
     rule_of[i] = std::int8_t(rule);
     new_slots[i] = std::uint32_t(daughters_per_split<D>() - 1);
+  }
+};
+
+// Step (3), the rule every backend applies: a mother is accepted when all her new slots lie within
+// `room` = capacity - count. The scan runs over every candidate, refused or not, so the accepted
+// mothers are the lowest-index ones, whatever order threads or blocks run in.
+TURBID_HD inline bool split_accepted(std::uint64_t first_slot, std::uint32_t new_slots, std::uint64_t room) {
+  return new_slots != 0 && first_slot + new_slots <= room;
+}
+
+// What a split reports, gathered per particle and combined (sums, max and min: exact in any order,
+// so a parallel reduction gives what a loop over the particles gives).
+struct SplitTally {
+  std::uint64_t splits;
+  std::uint64_t refused;
+  std::uint64_t added;     // new slots up to the last accepted mother (her inclusive scan)
+  std::uint32_t next_id;   // one past the largest id present: daughters' ids start here
+  Real smallest_h;         // half the smallest accepted mother's h
+
+  // The identity of CombineSplitTally (a plain aggregate, so device reductions may hold it raw).
+  TURBID_HD static SplitTally none() { return {0, 0, 0, 0, std::numeric_limits<Real>::max()}; }
+  TURBID_HD static SplitTally of(std::uint32_t id, Real h, std::uint64_t first_slot, std::uint32_t new_slots,
+                                 std::uint64_t room) {
+    SplitTally t = none();
+    t.next_id = id + 1u;
+    if (new_slots == 0) return t;
+    if (split_accepted(first_slot, new_slots, room)) {
+      t.splits = 1;
+      t.added = first_slot + new_slots;
+      t.smallest_h = Real(0.5) * h;
+    } else {
+      t.refused = 1;
+    }
+    return t;
+  }
+};
+
+struct CombineSplitTally {
+  TURBID_HD SplitTally operator()(const SplitTally& a, const SplitTally& b) const {
+    SplitTally t = SplitTally::none();
+    t.splits = a.splits + b.splits;
+    t.refused = a.refused + b.refused;
+    t.added = a.added < b.added ? b.added : a.added;
+    t.next_id = a.next_id < b.next_id ? b.next_id : a.next_id;
+    t.smallest_h = b.smallest_h < a.smallest_h ? b.smallest_h : a.smallest_h;
+    return t;
+  }
+};
+
+// Every registered field of one backend's storage, so a split carries each by its Carry rule without
+// code per field (a field registered later is carried too). Passed by value into the write pass.
+constexpr int kMaxSplitFields = 32;
+
+struct SplitFieldTable {
+  struct Field {
+    std::byte* data = nullptr;
+    std::uint32_t bytes = 0;      // per particle
+    std::uint16_t components = 0;
+    ScalarType type = ScalarType::f32;
+    Carry carry = Carry::copy;
+  };
+  int count = 0;
+  Field field[kMaxSplitFields];
+
+  // Particle `to` becomes a copy of particle `from` in every field.
+  TURBID_HD void copy(std::size_t from, std::size_t to) const {
+    for (int f = 0; f < count; ++f) {
+      const Field& F = field[f];
+      std::memcpy(F.data + to * F.bytes, F.data + from * F.bytes, F.bytes);
+    }
+  }
+  // Particle i's value of every Carry::divide field divided by `shares` (the daughters that share it).
+  TURBID_HD void divide(std::size_t i, int shares) const {
+    for (int f = 0; f < count; ++f) {
+      const Field& F = field[f];
+      if (F.carry != Carry::divide) continue;
+      if (F.type == ScalarType::f32) {
+        float* v = reinterpret_cast<float*>(F.data) + i * F.components;
+        for (int k = 0; k < F.components; ++k) v[k] /= float(shares);
+      } else if (F.type == ScalarType::f64) {
+        double* v = reinterpret_cast<double*>(F.data) + i * F.components;
+        for (int k = 0; k < F.components; ++k) v[k] /= double(shares);
+      }
+    }
+  }
+};
+
+// The first `count` fields of `store`'s registry, with their data where data_of(FieldId) says (the
+// host store's arrays, or a device copy of them).
+template <class DataOf>
+SplitFieldTable split_field_table(const ParticleStore& store, int count, DataOf&& data_of) {
+  if (count > kMaxSplitFields)
+    throw std::length_error("splitting carries at most " + std::to_string(kMaxSplitFields) + " particle fields, the store has " +
+                            std::to_string(count));
+  SplitFieldTable t;
+  t.count = count;
+  for (int f = 0; f < count; ++f) {
+    const FieldDesc& d = store.desc(f);
+    t.field[f].data = static_cast<std::byte*>(data_of(FieldId(f)));
+    t.field[f].bytes = std::uint32_t(store.field_bytes(f));
+    t.field[f].components = std::uint16_t(d.components);
+    t.field[f].type = d.type;
+    t.field[f].carry = d.carry;
+  }
+  return t;
+}
+
+// Step (4) for every particle i < n (the count before the split): an accepted mother copies herself
+// into her new slots n + first_slot[i] + k - 1 (k = 1..2^D-1), then each of her 2^D daughters (k = 0
+// in her own slot) takes its share of the divided fields, its sub-cube centre, h/2 and the rule's
+// material; daughters beyond the first get fresh ids in slot order. A thread writes only its
+// mother's slots and reads only her values, so any schedule gives the same bytes.
+template <int D>
+struct SplitWritePass {
+  SplitFieldTable fields;
+  ParticleView<D> P;
+  DriftPass<D> periodic;  // only its wrap(): daughters of a mother near a periodic face
+  SplitParams sp;
+  const std::uint32_t* new_slots = nullptr;
+  const std::int8_t* rule_of = nullptr;
+  const std::uint64_t* first_slot = nullptr;
+  std::uint64_t room = 0;
+  std::uint32_t n = 0;
+  std::uint32_t next_id = 0;
+  std::uint32_t* id = nullptr;
+
+  TURBID_HD void operator()(std::uint32_t i) const {
+    if (!split_accepted(first_slot[i], new_slots[i], room)) return;
+    constexpr int kD = daughters_per_split<D>();
+    const SplitRule& rule = sp.rules[rule_of[i]];
+    const std::size_t base = std::size_t(n) + first_slot[i];  // daughter k >= 1 goes to base + k - 1
+    const Vec<D> x0 = P.position[i];
+    const Real edge = split_edge<D>(P.mass[i], P.density[i]);
+    const Real h = P.smoothing_length[i];
+    for (int k = 1; k < kD; ++k) fields.copy(i, base + std::size_t(k - 1));
+    for (int k = 0; k < kD; ++k) {
+      const std::size_t slot = k == 0 ? i : base + std::size_t(k - 1);
+      fields.divide(slot, kD);
+      // +-a/4 is exact (a power-of-two scaling), so where a compiler fuses it with the addition
+      // (nvcc does) the position has the same bits.
+      P.position[slot] = periodic.wrap(x0 + daughter_offset<D>(k, edge));
+      P.smoothing_length[slot] = Real(0.5) * h;
+      P.material[slot] = rule.to;
+      if (k > 0) id[slot] = next_id + std::uint32_t(first_slot[i]) + std::uint32_t(k - 1);
+    }
   }
 };
 

@@ -5,11 +5,15 @@
 // the sorted order and removed count exactly (same keys, both sorts stable), pair counts exactly,
 // density rates and accelerations within 1e-5 of the largest magnitude in the block (float32
 // sums in a different association and with fused multiply-adds on the GPU), and a first step.
+// Splitting (sph/splitting.hpp) on the same lattices on both backends: the same counts and the
+// same bytes in every field (flag, scan, capacity rule and writes are integer work or correctly
+// rounded float operations on both), the full-store refusal, and conservation on the GPU.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <numeric>
@@ -22,6 +26,7 @@
 #include "sph/fields.hpp"
 #include "sph/particle_store.hpp"
 #include "sph/physics_params.hpp"
+#include "sph/split_params.hpp"
 #include "sph/vec.hpp"
 
 namespace {
@@ -283,5 +288,219 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"cubic_antuono_laminar_2d", 2, KernelKind::cubic_spline, Diffusion::antuono, Viscosity::laminar},
                       Case{"wendland_molteni_3d", 3, KernelKind::wendland_c2, Diffusion::molteni, Viscosity::artificial}),
     [](const ::testing::TestParamInfo<Case>& info) { return std::string(info.param.name); });
+
+// ---- splitting on both backends (GPU only) -----------------------------------------------------
+
+constexpr double kSlideRho = 1950.0;  // debris and turbidity reference density [kg/m^3]
+
+// As in test_splitting.cpp: variable h (a scene with transitions runs that path), rheology on so
+// the shear stress the criterion reads is registered, water (0), debris (1) and turbidity (2).
+PhysicsParams splitting_params(int d) {
+  PhysicsParams p;
+  p.dimensions = d;
+  p.smoothing_length = Real(2.0 * kDx);
+  p.max_smoothing_length = p.smoothing_length;
+  p.uniform_h = false;
+  p.diffusion = Diffusion::none;
+  p.viscosity = Viscosity::laminar;
+  p.rheology = true;
+  p.material_count = 3;
+  for (int m = 0; m < 3; ++m) {
+    p.materials[m].eos = TaitEos::make(m == 0 ? kRho0 : kSlideRho, 30.0, 7.0, 0.0);
+    p.materials[m].sound_speed = Real(30.0);
+    p.materials[m].dynamic_viscosity = Real(1e-3);
+  }
+  return p;
+}
+
+SplitParams debris_to_turbidity(double threshold, bool interface_only) {
+  SplitParams sp;
+  sp.rule_count = 1;
+  sp.rules[0].from = 1;
+  sp.rules[0].to = 2;
+  sp.rules[0].threshold = Real(threshold);
+  sp.rules[0].interface_only = interface_only;
+  sp.rules[0].min_smoothing_length = Real(1.5 * kDx);  // one level: daughters do not split again
+  return sp;
+}
+
+// n^D particles on a lattice of spacing kDx with random velocities, densities within 0.5% of
+// kSlideRho and masses within 1% of rho dx^D; material(x) and the shear stress stress(i) [Pa] by index.
+template <int D, class Material, class Stress>
+FieldIds build_lattice(ParticleStore& s, const PhysicsParams& p, Domain& dom, int n, std::size_t capacity,
+                       Material material, Stress stress) {
+  const FieldIds ids = register_fields(s, p);
+  std::size_t count = 1;
+  for (int k = 0; k < D; ++k) {
+    dom.min[k] = -0.1;
+    dom.max[k] = n * kDx + 0.1;
+    count *= std::size_t(n);
+  }
+  s.reserve(capacity);
+  s.resize(count);
+  std::mt19937 g(42);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  for (std::size_t i = 0; i < count; ++i) {
+    Vec<D> x, v;
+    std::size_t r = i;
+    for (int k = 0; k < D; ++k) {
+      x[k] = Real((double(r % std::size_t(n)) + 0.5) * kDx);
+      r /= std::size_t(n);
+      v[k] = Real(u(g));
+    }
+    const double rho = kSlideRho * (1.0 + 0.01 * u(g));
+    s.data<Vec<D>>(ids.position)[i] = x;
+    s.data<Vec<D>>(ids.velocity)[i] = v;
+    s.data<Real>(ids.density)[i] = Real(rho);
+    // Masses vary on their own, so the volumes m/rho (and the cube roots of the 3D edges) do too.
+    s.data<Real>(ids.mass)[i] = Real(rho * std::pow(kDx, D) * (1.0 + 0.02 * u(g)));
+    s.data<Real>(ids.smoothing_length)[i] = p.smoothing_length;
+    s.data<std::uint8_t>(ids.kind)[i] = std::uint8_t(Kind::fluid);
+    s.data<std::uint8_t>(ids.material)[i] = std::uint8_t(material(x));
+    s.data<std::uint32_t>(ids.id)[i] = std::uint32_t(i);
+    s.data<Real>(ids.shear_stress)[i] = Real(stress(i));
+  }
+  return ids;
+}
+
+// Mass, linear momentum and kinetic energy of a store, summed in double over its float fields.
+struct Totals {
+  double mass = 0, energy = 0, momentum_scale = 0;  // scale: sum m |v_k| (the momentum may be near 0)
+  double momentum[3] = {0, 0, 0};
+};
+
+template <int D>
+Totals totals(const ParticleStore& s, const FieldIds& ids) {
+  Totals t;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const double m = s.data<Real>(ids.mass)[i];
+    const Vec<D>& v = s.data<Vec<D>>(ids.velocity)[i];
+    t.mass += m;
+    for (int k = 0; k < D; ++k) {
+      t.momentum[k] += m * double(v[k]);
+      t.momentum_scale += m * std::abs(double(v[k]));
+      t.energy += 0.5 * m * double(v[k]) * double(v[k]);
+    }
+  }
+  return t;
+}
+
+struct SplitRun {
+  SplitCounts cpu, gpu;
+  std::size_t before = 0;
+};
+
+// Builds the same lattice twice, splits it on the CPU (2 threads) and the GPU after one neighbour
+// update (the same sorted order on both, see the parity test above), and checks the counts, the
+// sizes and every field byte for byte. Conservation is checked on the GPU's store.
+template <int D, class Material, class Stress>
+SplitRun split_on_both(int n, std::size_t capacity, Material material, Stress stress, const SplitParams& rules) {
+  SplitRun run;
+  const PhysicsParams p = splitting_params(D);
+  ParticleStore cpu_store, gpu_store;
+  Domain dom;
+  const FieldIds ids = build_lattice<D>(cpu_store, p, dom, n, capacity, material, stress);
+  build_lattice<D>(gpu_store, p, dom, n, capacity, material, stress);
+  auto cpu = make_cpu_backend(2);
+  auto gpu = make_cuda_backend();
+  EXPECT_TRUE(gpu->supports_splitting());
+  cpu->bind(cpu_store, ids, p, dom);
+  gpu->bind(gpu_store, ids, p, dom);
+  EXPECT_EQ(cpu->update_neighbours(), 0u);
+  EXPECT_EQ(gpu->update_neighbours(), 0u);
+  gpu->sync_to_host();
+  run.before = gpu_store.size();
+  const Totals t0 = totals<D>(gpu_store, ids);
+
+  run.cpu = cpu->split(rules);
+  run.gpu = gpu->split(rules);
+  EXPECT_EQ(run.gpu.splits, run.cpu.splits);
+  EXPECT_EQ(run.gpu.daughters, run.cpu.daughters);
+  EXPECT_EQ(run.gpu.refused, run.cpu.refused);
+  EXPECT_EQ(run.gpu.smallest_h, run.cpu.smallest_h);
+  EXPECT_EQ(gpu_store.size(), cpu_store.size()) << "the host count follows the device at the split";
+  gpu->sync_to_host();
+  EXPECT_EQ(cpu_store.size(), run.before + run.cpu.daughters);
+  EXPECT_LE(cpu_store.size(), cpu_store.capacity());
+  if (gpu_store.size() != cpu_store.size()) {
+    ADD_FAILURE() << "sizes differ: cpu " << cpu_store.size() << ", gpu " << gpu_store.size();
+    return run;
+  }
+  for (int f = 0; f < cpu_store.field_count(); ++f)
+    EXPECT_EQ(std::memcmp(cpu_store.raw(f), gpu_store.raw(f), cpu_store.size() * cpu_store.field_bytes(f)), 0)
+        << "field " << cpu_store.desc(f).name << " differs between the backends";
+
+  // Conservation on the GPU (float32 fields, double sums): each daughter's m / 2^D is exact and the
+  // velocities are copied, so the totals agree to the summation order (1e-12 on the CPU); the bound
+  // asked of a float engine is 1e-6 relative.
+  const Totals t1 = totals<D>(gpu_store, ids);
+  EXPECT_NEAR(t1.mass, t0.mass, 1e-6 * t0.mass) << "mass";
+  EXPECT_NEAR(t1.energy, t0.energy, 1e-6 * t0.energy) << "kinetic energy";
+  for (int k = 0; k < D; ++k)
+    EXPECT_NEAR(t1.momentum[k], t0.momentum[k], 1e-6 * t0.momentum_scale) << "momentum, axis " << k;
+
+  // The grid is stale after a split: both backends sort the daughters in, in the same order.
+  EXPECT_EQ(cpu->update_neighbours(), 0u);
+  EXPECT_EQ(gpu->update_neighbours(), 0u);
+  gpu->sync_to_host();
+  EXPECT_EQ(gpu_store.size(), cpu_store.size());
+  if (gpu_store.size() != cpu_store.size()) return run;
+  const std::uint32_t* id_cpu = cpu_store.data<std::uint32_t>(ids.id);
+  EXPECT_TRUE(std::equal(id_cpu, id_cpu + cpu_store.size(), gpu_store.data<std::uint32_t>(ids.id))) << "sorted order";
+  EXPECT_EQ(gpu->pair_count(), cpu->pair_count());
+  return run;
+}
+
+// Debris in the lower half under water, stress 0..299 Pa in a fixed pattern, threshold 150 Pa,
+// only particles next to the water (`where: interface`) split.
+TEST(CudaSplitting, InterfaceSplitMatchesCpuBitwise2D) {
+  std::string reason;
+  if (cuda_device_count(&reason) == 0) GTEST_SKIP() << reason;
+  constexpr int n = 40;
+  const SplitRun r = split_on_both<2>(
+      n, std::size_t(n * n) * 4, [](const Vec<2>& x) { return x[1] < Real(0.2) ? 1 : 0; },
+      [](std::size_t i) { return double((i * 53) % 300); }, debris_to_turbidity(150.0, true));
+  EXPECT_GT(r.cpu.splits, 10u);
+  EXPECT_EQ(r.cpu.refused, 0u);
+}
+
+// 3D, every debris particle above the threshold splits (8 daughters; the cube root of the edge).
+TEST(CudaSplitting, SplitMatchesCpuBitwise3D) {
+  std::string reason;
+  if (cuda_device_count(&reason) == 0) GTEST_SKIP() << reason;
+  constexpr int n = 12;
+  const SplitRun r = split_on_both<3>(
+      n, std::size_t(n * n * n) * 8, [](const Vec<3>& x) { return x[2] < Real(0.08) ? 1 : 0; },
+      [](std::size_t i) { return double((i * 37) % 200); }, debris_to_turbidity(100.0, false));
+  EXPECT_GT(r.cpu.splits, 300u);
+  EXPECT_EQ(r.cpu.daughters, 7 * r.cpu.splits);
+  EXPECT_EQ(r.cpu.refused, 0u);
+}
+
+// 3D with `where: interface`: the neighbour search of the flag pass on the GPU's grid.
+TEST(CudaSplitting, InterfaceSplitMatchesCpuBitwise3D) {
+  std::string reason;
+  if (cuda_device_count(&reason) == 0) GTEST_SKIP() << reason;
+  constexpr int n = 12;
+  const SplitRun r = split_on_both<3>(
+      n, std::size_t(n * n * n) * 8, [](const Vec<3>& x) { return x[2] < Real(0.06) ? 1 : 0; },
+      [](std::size_t i) { return double((i * 37) % 200); }, debris_to_turbidity(50.0, true));
+  EXPECT_GT(r.cpu.splits, 50u);
+  EXPECT_EQ(r.cpu.refused, 0u);
+}
+
+// Room for 10 splits (30 new slots in 2D) among 50 candidates: on both backends the 10 lowest-index
+// candidates split and 40 are refused, and nothing is written past the capacity.
+TEST(CudaSplitting, FullStoreRefusesTheSameMothers) {
+  std::string reason;
+  if (cuda_device_count(&reason) == 0) GTEST_SKIP() << reason;
+  constexpr int n = 10;
+  const SplitRun r = split_on_both<2>(
+      n, std::size_t(n * n) + 31, [](const Vec<2>&) { return 1; },
+      [](std::size_t i) { return i % 2 == 0 ? 200.0 : 0.0; }, debris_to_turbidity(150.0, false));
+  EXPECT_EQ(r.gpu.splits, 10u);
+  EXPECT_EQ(r.gpu.refused, std::size_t(n * n / 2 - 10));
+  EXPECT_EQ(r.gpu.daughters, 30u);
+}
 
 }  // namespace

@@ -348,6 +348,36 @@ TEST(Splitting, SummationDensityInsideASplitBlockIsTheMothers) {
   // 4.8%, measured by the same sum); the issue asks 2%. Printed above, not asserted yet.
 }
 
+// The 3D edge's cube root is correctly rounded (so the CPU and the GPU agree to the bit), checked
+// exactly in integers: v = V 2^ev and r = R 2^er with 24-bit V and R; r is the nearest float to
+// cbrt(v) when (R - 1/2)^3 2^(3 er) < v < (R + 1/2)^3 2^(3 er), i.e. (2R -+ 1)^3 against
+// V 2^(ev - 3 er + 3), all below 2^124 for volumes between 1e-15 and 1e3.
+TEST(Splitting, CubeRootIsCorrectlyRounded) {
+  using i128 = __int128;
+  const auto mantissa = [](float x, int& e) {
+    const float f = std::frexp(x, &e);  // x = f 2^e, f in [0.5, 1)
+    e -= 24;
+    return std::int64_t(std::ldexp(f, 24));
+  };
+  std::size_t libm_differs = 0, checked = 0;
+  for (double v0 = 1e-15; v0 < 1e3; v0 *= 1.0001) {
+    const float v = float(v0);
+    const float r = cube_root_rn(v);
+    int ev = 0, er = 0;
+    const i128 V = mantissa(v, ev), R = mantissa(r, er);
+    const int shift = ev - 3 * er + 3;
+    ASSERT_TRUE(shift >= 0 && shift < 100) << v;  // about 51: 24-bit V against 72-bit R^3
+    const i128 lhs = V << shift;
+    const auto cube = [](i128 m) { return m * m * m; };
+    EXPECT_LT(cube(2 * R - 1), lhs) << "v = " << v << ", r = " << r;
+    EXPECT_GT(cube(2 * R + 1), lhs) << "v = " << v << ", r = " << r;
+    libm_differs += std::cbrt(v) != r ? 1 : 0;
+    ++checked;
+  }
+  std::printf("cube root: %zu volumes checked, libm's cbrtf differs from the correctly rounded root in %zu\n", checked,
+              libm_differs);
+}
+
 TEST(Splitting, DivideCarryNeedsFloatingPoint) {
   ParticleStore s;
   EXPECT_THROW(s.add_field({"count", "", ScalarType::u32, 1, false, true, true, Carry::divide}), std::invalid_argument);

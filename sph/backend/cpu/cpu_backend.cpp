@@ -118,9 +118,9 @@ class CpuBackend final : public Backend {
   }
 
  private:
-  // Splitting in the four steps of sph/splitting.hpp. The scan and the capacity test run on one
-  // thread (one add per particle); flags and writes in parallel, each mother writing only her own
-  // slots, so the result is the same for every thread count.
+  // Splitting in the four steps of sph/splitting.hpp. The scan and the tally of the capacity test
+  // run on one thread (one add per particle); flags and writes in parallel, each mother writing
+  // only her own slots, so the result is the same for every thread count.
   template <int D>
   SplitCounts split_impl(const SplitParams& rules) {
     SplitCounts c;
@@ -140,53 +140,22 @@ class CpuBackend final : public Backend {
     }
     std::exclusive_scan(new_slots_.begin(), new_slots_.end(), first_slot_.begin(), std::uint64_t(0));
     const std::uint64_t room = store_->capacity() - n;
-    std::uint64_t added = 0;
-    for (std::uint32_t i = 0; i < n; ++i) {
-      if (new_slots_[i] == 0) continue;
-      if (first_slot_[i] + new_slots_[i] <= room) {
-        ++c.splits;
-        added = first_slot_[i] + new_slots_[i];
-      } else {
-        ++c.refused;
-        new_slots_[i] = 0;
-      }
-    }
+    const Real* h = store_->data<Real>(ids_.smoothing_length);
+    const std::uint32_t* id = store_->data<std::uint32_t>(ids_.id);
+    SplitTally t = SplitTally::none();
+    const CombineSplitTally combine;
+    for (std::uint32_t i = 0; i < n; ++i) t = combine(t, SplitTally::of(id[i], h[i], first_slot_[i], new_slots_[i], room));
+    c.splits = t.splits;
+    c.refused = t.refused;
     if (c.splits == 0) return c;
-    {
-      const Real* h = store_->data<Real>(ids_.smoothing_length);
-      Real smallest = std::numeric_limits<Real>::max();
-      for (std::uint32_t i = 0; i < n; ++i)
-        if (new_slots_[i] != 0) smallest = std::min(smallest, Real(0.5) * h[i]);
-      c.smallest_h = smallest;
-    }
-    const std::uint32_t* id0 = store_->data<std::uint32_t>(ids_.id);
-    std::uint32_t next_id = 0;
-    const std::int64_t ni = n;
-#pragma omp parallel for reduction(max : next_id) schedule(static) if (ni >= kParallelThreshold)
-    for (std::int64_t i = 0; i < ni; ++i) next_id = std::max(next_id, id0[i] + 1);
-    store_->resize(n + added);  // within the capacity: the arrays stay where they are
+    c.smallest_h = t.smallest_h;
+    store_->resize(n + t.added);  // within the capacity: the arrays stay where they are
     const ParticleView<D> P = view<D>();
-    std::uint32_t* id = store_->data<std::uint32_t>(ids_.id);
-    const DriftPass<D> wrap{P, Real(0), Real(0), params_};
-    constexpr int kD = daughters_per_split<D>();
-    parallel_for(n, [&](std::uint32_t i) {
-      if (new_slots_[i] == 0) return;
-      const SplitRule& rule = rules.rules[rule_of_[i]];
-      const std::size_t base = std::size_t(n) + first_slot_[i];  // daughter k >= 1 goes to base + k - 1
-      const Vec<D> x0 = P.position[i];
-      const Real edge = split_edge<D>(P.mass[i], P.density[i]);
-      const Real h = P.smoothing_length[i];
-      for (int k = 1; k < kD; ++k) store_->copy_particle(i, base + std::size_t(k - 1));
-      for (int k = 0; k < kD; ++k) {
-        const std::size_t slot = k == 0 ? i : base + std::size_t(k - 1);
-        store_->divide_shared(slot, kD);
-        P.position[slot] = wrap.wrap(x0 + daughter_offset<D>(k, edge));
-        P.smoothing_length[slot] = Real(0.5) * h;
-        P.material[slot] = rule.to;
-        if (k > 0) id[slot] = next_id + std::uint32_t(first_slot_[i]) + std::uint32_t(k - 1);
-      }
-    });
-    c.daughters = added;
+    const SplitFieldTable fields = split_field_table(*store_, store_->field_count(), [&](FieldId f) { return store_->raw(f); });
+    parallel_for(n, SplitWritePass<D>{fields, P, DriftPass<D>{P, Real(0), Real(0), params_}, rules, new_slots_.data(),
+                                      rule_of_.data(), first_slot_.data(), room, n, t.next_id,
+                                      store_->data<std::uint32_t>(ids_.id)});
+    c.daughters = t.added;
     list_valid_ = false;
     soa_valid_ = false;
     return c;

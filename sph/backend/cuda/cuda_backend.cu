@@ -1,7 +1,8 @@
 // The CUDA backend: the same pass functors as the CPU backend (passes.hpp) launched through one
 // generic kernel, a CUB radix sort by cell (stable, so the order equals the CPU counting sort's),
 // a generic gather of every field that follows the sort, and CUB reductions for step statistics,
-// health checks and pair counts. The passes search the grid every time: the NeighbourList and
+// health checks and pair counts; particle splitting runs the shared splitting passes around a CUB
+// exclusive scan (sph/splitting.hpp), so it writes the CPU's bytes. The passes search the grid every time: the NeighbourList and
 // position_soa shortcuts are the CPU's, and they visit the same pairs in the same order.
 // Device memory holds one buffer per registered field, sized from the field registry, so a new
 // field needs no code here. The store on the host is current only after sync_to_host(); its size
@@ -10,6 +11,8 @@
 // Kept thin on purpose: no logging, YAML, JSON or CLI headers (they break nvcc in C++20).
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_reduce.cuh>
+#include <cub/device/device_scan.cuh>
+#include <cuda/std/functional>
 #include <cuda_runtime.h>
 
 #include <algorithm>
@@ -27,6 +30,7 @@
 #include "sph/boundary_passes.hpp"
 #include "sph/dispatch.hpp"
 #include "sph/passes.hpp"
+#include "sph/splitting.hpp"
 
 #ifndef TURBID_CUDA_ARCHITECTURES
 #define TURBID_CUDA_ARCHITECTURES "unknown"
@@ -176,6 +180,17 @@ struct PairCountPass {
   }
 };
 
+// What each particle adds to a split's counts (SplitTally::of, the CPU's rule); summed by CUB.
+struct SplitTallyPass {
+  const std::uint32_t* id;
+  const Real* h;
+  const std::uint64_t* first_slot;
+  const std::uint32_t* new_slots;
+  std::uint64_t room;
+  SplitTally* out;
+  __device__ void operator()(std::uint32_t i) const { out[i] = SplitTally::of(id[i], h[i], first_slot[i], new_slots[i], room); }
+};
+
 // ---- the backend -----------------------------------------------------------------------------
 
 // Runs a CUB device algorithm twice: once to size its temporary storage, once to do the work.
@@ -275,6 +290,11 @@ class CudaBackend final : public Backend {
     if (params_.body_count == 0 || ids_.structure_force < 0) return std::vector<BodyLoad>(reference.size());
     if (params_.dimensions == 2) return loads_impl<2>(reference);
     return loads_impl<3>(reference);
+  }
+
+  bool supports_splitting() const override { return true; }
+  SplitCounts split(const SplitParams& rules) override {
+    return params_.dimensions == 2 ? split_impl<2>(rules) : split_impl<3>(rules);
   }
 
   template <int D>
@@ -456,6 +476,64 @@ class CudaBackend final : public Backend {
     });
   }
 
+  // Splitting in the four steps of sph/splitting.hpp, as the CPU backend does them: the flag pass,
+  // an exclusive scan of the new slots, the capacity rule tallied per particle and reduced (the
+  // counts, the last accepted mother's slots, the smallest daughter h, the next free id), then the
+  // write pass. Only the tally comes back to the host; the store on the host gets the new count
+  // now and the data at sync_to_host().
+  template <int D>
+  SplitCounts split_impl(const SplitParams& rules) {
+    SplitCounts c;
+    const std::uint32_t n = n_;
+    if (rules.rule_count == 0 || n == 0) return c;
+    // Allocated at the first split, for the whole capacity: scenes without transitions hold none.
+    split_slots_.ensure(capacity_ * sizeof(std::uint32_t));
+    split_rule_.ensure(capacity_ * sizeof(std::int8_t));
+    split_first_.ensure(capacity_ * sizeof(std::uint64_t));
+    split_tally_.ensure(capacity_ * sizeof(SplitTally));
+    result_.ensure(sizeof(SplitTally));
+    std::uint32_t* slots = split_slots_.as<std::uint32_t>();
+    std::int8_t* rule_of = split_rule_.as<std::int8_t>();
+    std::uint64_t* first = split_first_.as<std::uint64_t>();
+    SplitTally* tally = split_tally_.as<SplitTally>();
+    const ParticleView<D> P = view<D>();
+    const GridView<D> G = grid<D>();
+    dispatch_kernel<D>(params_, [&](auto kernel_tag, auto uniform_tag) {
+      using K = typename decltype(kernel_tag)::type;
+      constexpr bool U = decltype(uniform_tag)::value;
+      launch("SplitFlagPass", n, SplitFlagPass<D, K, U>{P, G, params_, rules, slots, rule_of});
+    });
+    // ExclusiveSum would add in the counts' own type (32 bits); a 64-bit initial value makes CUB
+    // accumulate in 64 bits, like the CPU's std::exclusive_scan.
+    TURBID_CUB_CALL("cub::DeviceScan::ExclusiveScan(split slots)",
+                    cub::DeviceScan::ExclusiveScan(cub_temp, cub_temp_bytes, slots, first, ::cuda::std::plus<>{},
+                                                   std::uint64_t(0), n));
+    // The store's capacity, as on the CPU (the device buffers hold at least as much).
+    const std::uint64_t capacity = std::min<std::uint64_t>(capacity_, store_->capacity());
+    const std::uint64_t room = capacity > n ? capacity - n : 0;
+    std::uint32_t* id = fields_[std::size_t(ids_.id)].as<std::uint32_t>();
+    launch("SplitTallyPass", n, SplitTallyPass{id, P.smoothing_length, first, slots, room, tally});
+    TURBID_CUB_CALL("cub::DeviceReduce::Reduce(split tally)",
+                    cub::DeviceReduce::Reduce(cub_temp, cub_temp_bytes, tally, result_.as<SplitTally>(), n,
+                                              CombineSplitTally{}, SplitTally::none()));
+    const SplitTally t = download_result<SplitTally>();
+    c.splits = t.splits;
+    c.refused = t.refused;
+    if (c.splits == 0) return c;
+    c.smallest_h = t.smallest_h;
+    // Every field on the device (one registered on the host after bind() stays there, as in sync_to_host()).
+    const int on_device = std::min(store_->field_count(), int(fields_.size()));
+    const SplitFieldTable table =
+        split_field_table(*store_, on_device, [&](FieldId f) { return fields_[std::size_t(f)].get(); });
+    launch("SplitWritePass", n,
+           SplitWritePass<D>{table, P, DriftPass<D>{P, Real(0), Real(0), params_}, rules, slots, rule_of, first, room, n,
+                             t.next_id, id});
+    n_ = std::uint32_t(n + t.added);
+    store_->resize(n_);  // within the capacity; the host's data follow at sync_to_host()
+    c.daughters = t.added;
+    return c;
+  }
+
   template <int D>
   StepStats stats_impl() {
     const std::uint32_t n = n_;
@@ -527,6 +605,7 @@ class CudaBackend final : public Backend {
   DeviceBuffer scratch_;              // gather target, capacity x widest field
   DeviceBuffer cell_start_, keys_in_, keys_out_, values_in_, values_out_;
   DeviceBuffer reduce_in_, result_, temp_;
+  DeviceBuffer split_slots_, split_rule_, split_first_, split_tally_;  // splitting only, from the first split
 };
 
 #undef TURBID_CUB_CALL
