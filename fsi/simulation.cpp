@@ -485,7 +485,7 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
   } else if (options.backend == "auto") {
     std::string why;
     backend = sph::cuda_device_count(&why) > 0 ? sph::make_cuda_backend() : sph::make_cpu_backend(options.threads);
-    // Splitting is not on every backend yet: a scene with transitions then runs on the CPU.
+    // A backend without splitting hands a scene with transitions to the CPU.
     if (!scene_.transitions.empty() && !backend->supports_splitting()) backend = sph::make_cpu_backend(options.threads);
   } else {
     throw std::invalid_argument("unknown backend '" + options.backend + "' (expected auto, cpu or cuda)");
