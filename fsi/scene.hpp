@@ -193,6 +193,7 @@ struct NumericsSpec {
   BoundaryKind boundary = BoundaryKind::dbc;  // wall treatment for walls and structures
   bool no_slip = false;                    // mDBC: boundary velocity mirrors the fluid's (no-slip walls)
   bool interface_correction = true;        // ghost-density correction across material interfaces (paper eq. 3)
+  int split_relaxation = 10;               // relaxation steps after each split (sph/splitting.hpp); 0 = off
   double shifting_coefficient = 0;         // particle shifting A [-]; 0 = off
   double shifting_surface_threshold = -1;  // div r below this: free surface, not shifted; < 0: D - 0.5
 };

@@ -429,6 +429,7 @@ sph::PhysicsParams physics_params(const Scene& scene) {
     // the per-particle h from the start.
     p.rheology = true;
     p.uniform_h = false;
+    p.splitting = true;
   }
   p.wall_material = 0;
   p.interface_correction = scene.numerics.interface_correction && p.material_count > 1;
@@ -514,6 +515,7 @@ sph::SplitParams split_params(const Scene& scene) {
     if (m < 0) throw std::invalid_argument("transition names an unknown material '" + name + "'");
     return std::uint8_t(m);
   };
+  sp.relax_iterations = scene.numerics.split_relaxation;
   for (const auto& t : scene.transitions) {
     sph::SplitRule& r = sp.rules[sp.rule_count++];
     r.from = index(t.from);

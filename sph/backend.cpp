@@ -9,4 +9,8 @@ SplitCounts Backend::split(const SplitParams&) {
   throw std::logic_error("particle splitting is not implemented on the " + name() + " backend yet");
 }
 
+std::size_t Backend::relax_split(const SplitParams&) {
+  throw std::logic_error("the relaxation after a split is not implemented on the " + name() + " backend yet");
+}
+
 }  // namespace turbid::sph

@@ -64,6 +64,10 @@ class Backend {
   // force pass. Afterwards the grid is stale: the caller updates neighbours and forces.
   virtual SplitCounts split(const SplitParams& rules);
   virtual bool supports_splitting() const { return false; }
+  // Relaxes the daughters of the last split and the fluid around them (sph/splitting.hpp: the zone,
+  // then rules.relax_iterations Jacobi steps); needs the neighbours updated after the split.
+  // Returns the number of particles in the zone.
+  virtual std::size_t relax_split(const SplitParams& rules);
 };
 
 std::unique_ptr<Backend> make_cpu_backend(int threads);

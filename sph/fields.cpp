@@ -48,6 +48,10 @@ FieldIds register_fields(ParticleStore& s, const PhysicsParams& p, bool structur
     f.shear_stress = s.add_field({"shear_stress", "Pa", ScalarType::f32, 1, true, false, false, Carry::recompute});
   }
   if (p.zone_count > 0) f.zone = s.add_field({"zone", "", ScalarType::u8, 1, true, true, true, Carry::copy});
+  // Set by a split for its daughters and cleared by the next one; between steps it is read only by
+  // the relaxation right after the split, so it is neither written out nor checkpointed.
+  if (p.splitting)
+    f.split_fresh = s.add_field({"split_fresh", "", ScalarType::u8, 1, false, false, true, Carry::copy});
   if (p.free_slip_walls)
     f.free_slip = s.add_field({"free_slip", "", ScalarType::u8, 1, false, true, true, Carry::copy});
   return f;

@@ -16,6 +16,7 @@ struct FieldIds {
   FieldId zone = -1;                        // registered only with open boundaries
   FieldId free_slip = -1;                   // registered only with free-slip walls (1: the particle's wall slips)
   FieldId shifting_velocity = -1;           // registered only with particle shifting
+  FieldId split_fresh = -1;                 // registered only with transitions (1: daughter of the last split)
   FieldId shear_rate = -1, effective_viscosity = -1, shear_stress = -1;  // only with a non-Newtonian material
 };
 

@@ -42,6 +42,7 @@ struct ParticleView {
   Real* shear_rate = nullptr;          // only with a non-Newtonian material: sqrt(2 D:D) [1/s]
   Real* effective_viscosity = nullptr; // only with a non-Newtonian material: mu_eff [Pa s]
   Real* shear_stress = nullptr;        // only with a non-Newtonian material: sqrt(J2(tau)) = mu_eff gamma_dot [Pa]
+  std::uint8_t* split_fresh = nullptr; // only with transitions: 1 for the daughters of the last split
   // CPU only: positions as one array per coordinate (component a at a * soa_stride), a copy made
   // at each sort so that distance checks vectorise; valid until the next drift.
   const Real* position_soa = nullptr;

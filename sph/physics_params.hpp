@@ -95,6 +95,8 @@ struct PhysicsParams {
   // Some material is not Newtonian: a rheology pass computes each fluid particle's shear rate and
   // effective viscosity before the momentum pass (fields shear_rate, effective_viscosity, shear_stress).
   bool rheology = false;
+  // The scene has transitions: particles may split (sph/splitting.hpp; field split_fresh).
+  bool splitting = false;
   // The paper's ghost-density correction of density diffusion between fluids of different
   // materials (seed paper eq. 3); off: no diffusion across an interface.
   bool interface_correction = false;

@@ -70,6 +70,10 @@ class Solver {
     split_error_when_full_ = error_when_full;
   }
   const SplitCounts& split_totals() const { return split_totals_; }  // since the start of the run
+  // Wall time spent splitting (flag, insertion, relaxation, rebuild) and in whole steps since the
+  // start of this process's run [s]; measured only with transitions.
+  double split_seconds() const { return split_seconds_; }
+  double step_seconds() const { return step_seconds_; }
   void restore_split_totals(const SplitCounts& c) {
     split_totals_ = c;
     if (c.smallest_h > 0) lower_daughter_h(c.smallest_h);
@@ -90,6 +94,8 @@ class Solver {
   SplitParams split_;
   bool split_error_when_full_ = false;
   SplitCounts split_totals_;
+  double split_seconds_ = 0;  // wall time in split() (with transitions only) [s]
+  double step_seconds_ = 0;   // wall time of the steps, split included (with transitions only) [s]
   double time_ = 0;
   double last_dt_ = 0;
   std::uint64_t steps_ = 0;

@@ -21,6 +21,8 @@ struct SplitRule {
 struct SplitParams {
   int rule_count = 0;
   SplitRule rules[kMaxSplitRules];
+  int relax_iterations = 10;  // Jacobi steps of the relaxation after a split (0: none; sph/splitting.hpp)
+  Real relax_strength = Real(0.2);  // beta of the relaxation's displacement -beta h^2 grad(sum V W)
 };
 
 struct SplitCounts {

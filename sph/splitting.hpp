@@ -272,8 +272,138 @@ struct SplitWritePass {
       P.position[slot] = periodic.wrap(x0 + daughter_offset<D>(k, edge));
       P.smoothing_length[slot] = Real(0.5) * h;
       P.material[slot] = rule.to;
+      if (P.split_fresh) P.split_fresh[slot] = 1;  // the relaxation after the split starts from here
       if (k > 0) id[slot] = next_id + std::uint32_t(first_slot[i]) + std::uint32_t(k - 1);
     }
+  }
+};
+
+// Relaxation after a split (docs/choices.md, "Splitting"). Where daughters of h/2 meet particles of
+// h, no symmetric pair kernel gives both sides their summation density: on a lattice at rest the
+// kernel of the mean h puts the daughters on the edge of a split block 15.5% above the mother's
+// (tests/unit/test_splitting.cpp). A few Jacobi steps of a shifting displacement,
+//   dx_i = -beta h_i^2 sum_j V_j grad_i W(r_ij, h_ij)     (|dx_i| <= 0.05 h_i per step),
+// applied to the new daughters and to the fluid particles within a pair support of one, move that
+// zone towards a uniform kernel sum (below 1% on the lattice after 10 steps of beta = 0.2). Only
+// positions move: mass, velocities and densities stay, so mass, momentum and kinetic energy are
+// untouched, and the zone's mass-weighted mean displacement is removed, so the centre of mass stays.
+// Particles with a truncated kernel sum (below 0.8: a free surface) keep their place.
+inline constexpr Real kSplitRelaxMaxStep = Real(0.05);  // largest displacement per step [h_i]
+inline constexpr Real kSplitRelaxMinFill = Real(0.8);   // sum_j V_j W_ij below which a particle stays
+
+// zone[i] = 1 for a fluid particle that is a new daughter or has one within the pair's support.
+template <int D, class K, bool UniformH>
+struct SplitRelaxZonePass {
+  ParticleView<D> P;
+  GridView<D> G;
+  PhysicsParams prm;
+  std::uint8_t* zone = nullptr;
+
+  TURBID_HD void operator()(std::uint32_t i) const {
+    zone[i] = 0;
+    if (P.kind[i] != std::uint8_t(Kind::fluid)) return;
+    if (P.split_fresh[i]) {
+      zone[i] = 1;
+      return;
+    }
+    const Real h_i = UniformH ? prm.smoothing_length : P.smoothing_length[i];
+    bool near = false;
+    for_each_neighbour<D>(P, G, NeighbourList{}, prm, i, P.position[i], [&](std::uint32_t j, const Vec<D>&, Real r2) {
+      const Real h = pair_h<D, K>(P, prm, UniformH, h_i, j);
+      near = near || (P.split_fresh[j] && r2 < Real(4) * h * h);
+    });
+    zone[i] = near ? 1 : 0;
+  }
+};
+
+// One Jacobi step: shift[i] for the zone's particles from the positions as they are (zero elsewhere).
+template <int D, class K, bool UniformH>
+struct SplitRelaxShiftPass {
+  ParticleView<D> P;
+  GridView<D> G;
+  PhysicsParams prm;
+  const std::uint8_t* zone = nullptr;
+  Vec<D>* shift = nullptr;
+  Real strength = Real(0.2);  // beta
+
+  TURBID_HD void operator()(std::uint32_t i) const {
+    shift[i] = Vec<D>{};
+    if (!zone[i]) return;
+    const Real h_i = UniformH ? prm.smoothing_length : P.smoothing_length[i];
+    Real fill = K::w(Real(0), h_i) * P.mass[i] / P.density[i];
+    Vec<D> grad{};
+    for_each_neighbour<D>(P, G, NeighbourList{}, prm, i, P.position[i], [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
+      const Real h = pair_h<D, K>(P, prm, UniformH, h_i, j);
+      if (r2 >= Real(4) * h * h) return;
+      const Real r = std::sqrt(r2);
+      const Real vol = P.mass[j] / P.density[j];
+      fill += vol * K::w(r, h);
+      const Real F = K::f_inv(r, Real(1) / h);
+      for (int a = 0; a < D; ++a) grad[a] += vol * F * rij[a];
+    });
+    if (fill < kSplitRelaxMinFill) return;
+    Vec<D> s;
+    Real len2 = 0;
+    for (int a = 0; a < D; ++a) {
+      s[a] = -strength * h_i * h_i * grad[a];
+      len2 += s[a] * s[a];
+    }
+    const Real cap = kSplitRelaxMaxStep * h_i;
+    if (len2 > cap * cap) {
+      const Real k = cap / std::sqrt(len2);
+      for (int a = 0; a < D; ++a) s[a] *= k;
+    }
+    shift[i] = s;
+  }
+};
+
+// Applies shift[i] - mean (the zone's mass-weighted mean shift) to the zone, back into a periodic
+// domain where a particle crosses a face.
+template <int D>
+struct SplitRelaxApplyPass {
+  ParticleView<D> P;
+  DriftPass<D> periodic;  // only its wrap()
+  const std::uint8_t* zone = nullptr;
+  const Vec<D>* shift = nullptr;
+  Vec<D> mean{};
+
+  TURBID_HD void operator()(std::uint32_t i) const {
+    if (!zone[i]) return;
+    Vec<D> x = P.position[i];
+    for (int a = 0; a < D; ++a) x[a] += shift[i][a] - mean[a];
+    P.position[i] = periodic.wrap(x);
+  }
+};
+
+// The zone's count, mass and mass-weighted shift, per particle and summed (a device reduction).
+struct RelaxMoment {
+  double count;
+  double mass;
+  double moment[3];
+};
+
+struct SumRelaxMoment {
+  TURBID_HD RelaxMoment operator()(const RelaxMoment& a, const RelaxMoment& b) const {
+    return {a.count + b.count, a.mass + b.mass,
+            {a.moment[0] + b.moment[0], a.moment[1] + b.moment[1], a.moment[2] + b.moment[2]}};
+  }
+};
+
+template <int D>
+struct RelaxMomentPass {
+  const std::uint8_t* zone = nullptr;
+  const Real* mass = nullptr;
+  const Vec<D>* shift = nullptr;
+  RelaxMoment* out = nullptr;
+
+  TURBID_HD void operator()(std::uint32_t i) const {
+    RelaxMoment r{0, 0, {0, 0, 0}};
+    if (zone[i]) {
+      r.count = 1;
+      r.mass = double(mass[i]);
+      for (int a = 0; a < D; ++a) r.moment[a] = double(mass[i]) * double(shift[i][a]);
+    }
+    out[i] = r;
   }
 };
 

@@ -389,6 +389,10 @@ nlohmann::json run_scene(const RunRequest& request) {
     report["splits"] = c.splits;
     report["daughters_created"] = c.daughters;
     report["splits_refused"] = c.refused;
+    // Share of the step time the splitting takes (flag pass every step; insertion, relaxation and
+    // rebuild in steps with splits), this process only.
+    report["split_wall_seconds"] = sim.split_seconds();
+    report["split_share_of_step_time"] = sim.step_seconds() > 0 ? sim.split_seconds() / sim.step_seconds() : 0.0;
   }
   report["steps"] = sim.steps();
   report["simulated_time"] = sim.time();

@@ -541,10 +541,17 @@ fsi::Scene Reader::read(const std::string& yaml_text) {
 
 void Reader::read_numerics(const Value& v, fsi::NumericsSpec& n) const {
   MapView m(*this, v, {"kernel", "density_diffusion", "viscosity", "boundary", "shifting", "min_time_step",
-                                "max_density_variation", "interface_correction"});
+                                "max_density_variation", "interface_correction", "split_relaxation"});
   // Density diffusion between materials: the seed paper's ghost density (eq. 3), or none.
   if (auto ic = m.get("interface_correction"))
     n.interface_correction = choice(*ic, {"ghost_density", "none"}) == 0;
+  // Jacobi steps of the relaxation after each split (sph/splitting.hpp); 0 switches it off.
+  if (auto sr = m.get("split_relaxation")) {
+    n.split_relaxation = integer(*sr, 0, "an integer from 0 to 100 (relaxation steps after a split)");
+    if (n.split_relaxation > 100)
+      fail(sr->mark, "'split_relaxation' must be an integer from 0 to 100 (relaxation steps after a split), got " +
+                         std::to_string(n.split_relaxation));
+  }
   if (auto bv = m.get("boundary")) {
     MapView b(*this, *bv, {"type", "velocity"});
     n.boundary = choice(b.need("type"), {"dbc", "mdbc"}) == 0 ? fsi::BoundaryKind::dbc : fsi::BoundaryKind::mdbc;

@@ -21,6 +21,10 @@ step when a definition changes.
   poiseuille_*_2d      L2 error of the steady velocity profile (last VTK frame, bins of one
                        spacing) against physics.md D6; also the plug half-width's relative error.
   lock_exchange_*_2d   front speed U / sqrt(g' H) between x = 0.5 and 1.1 m.
+  submarine_landslide* suspended height of the soil (seed paper Table 1): at the last frame, the
+                       largest height above the bed, y - max(1.5 - x, 0) (the 45-degree slope, then
+                       the flat bottom), of the centre of any particle of a soil material (every
+                       fluid material but `water`: slide, turbidity); `suspended-height RUN...`.
 
 Run as a script, it plots the dam-break front of one or more runs against the experiment:
 
@@ -479,6 +483,31 @@ def plot_lock_exchange(runs, png, labels=None, depth=0.2):
     plt.close(fig)
 
 
+LANDSLIDE_SLOPE_TOE = 1.5  # x [m] where the 45-degree slope of the landslide scenes meets the bottom
+
+
+def suspended_height(run_dir, frame=-1):
+    """Highest soil particle above the bed at one frame (the last by default): (height [m], material,
+    x [m], y [m] of that particle, soil particles counted); soil = every fluid material but water."""
+    from turbid_vtp import frames, read_vtp
+
+    report, _ = read_run(run_dir)
+    names = [m["name"] for m in report["materials"]]
+    a = read_vtp(frames(run_dir)[frame][1])
+    best = (float("-inf"), None, None, None)
+    count = 0
+    dims = report["dimensions"]
+    for k in range(len(a["kind"])):
+        if a["kind"][k] != 0 or names[a["material"][k]] == "water":
+            continue
+        count += 1
+        x, y = float(a["Points"][k][0]), float(a["Points"][k][dims - 1])
+        height = y - max(LANDSLIDE_SLOPE_TOE - x, 0.0)
+        if height > best[0]:
+            best = (height, names[a["material"][k]], x, y)
+    return best + (count,)
+
+
 def main(argv):
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -490,6 +519,8 @@ def main(argv):
     lx.add_argument("runs", nargs="+", help="RUN_DIR:CONTRAST pairs, e.g. runs/lx5:0.05")
     lx.add_argument("--png", required=True)
     lx.add_argument("--labels", help="comma-separated legend labels, one per run")
+    sh = sub.add_parser("suspended-height", help="the soil's highest point above the bed (landslide runs)")
+    sh.add_argument("runs", nargs="+", help="run directories of a submarine_landslide scene")
     e = sub.add_parser("error", help="print the metric of a run directory")
     e.add_argument("scene", choices=sorted(METRICS))
     e.add_argument("run")
@@ -508,6 +539,11 @@ def main(argv):
         runs = [(r.rsplit(":", 1)[0], float(r.rsplit(":", 1)[1])) for r in args.runs]
         plot_lock_exchange(runs, args.png, args.labels.split(",") if args.labels else None)
         print(f"wrote {args.png}")
+    elif args.command == "suspended-height":
+        for run_dir in args.runs:
+            h, material, x, y, n = suspended_height(run_dir)
+            print(f"{run_dir}: suspended height {h:.4f} m ({material} particle at x = {x:.3f} m, "
+                  f"y = {y:.3f} m; {n} soil particles)")
     elif args.command == "error":
         m = METRICS[args.scene]
         print(f"{m['description']}: {m['error'](args.run):.6g}")

@@ -146,6 +146,8 @@ const BadScene kBadScenes[] = {
      "a capacity in a scene without transitions"},
     {"slip_artificial.yaml", 9, 45, "'slip: free' acts on the laminar viscosity term",
      "a free-slip wall where there is no laminar viscosity"},
+    {"split_relaxation_range.yaml", 6, 58, "'split_relaxation' must be an integer from 0 to 100 (relaxation steps after a "
+     "split), got 500", "a relaxation step count beyond its range, at the value"},
     {"transition_where.yaml", 13, 85, "'where' must be 'interface' or 'anywhere', got 'interfaces'",
      "an unknown 'where' of a transition"},
     {"structure_no_lift_3d.yaml", 13, 19, "needs 'lift_direction'",

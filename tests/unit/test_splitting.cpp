@@ -12,7 +12,8 @@
 //  - the outcome is bitwise the same for 1 and 2 threads;
 //  - summation density sum_j m_j W(r_ij, (h_i + h_j)/2) on a uniform 2D lattice at rest, before and
 //    after splitting a square block of it (reference: the mother's summation density): exact deep
-//    inside the split block; the blip on its edge, where daughters meet mothers, is printed (open).
+//    inside the split block; on its edge, where daughters meet mothers, within 2% after the
+//    relaxation that follows a split (the issue's bound), which keeps mass, energy and centre.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -48,6 +49,7 @@ PhysicsParams params(int d) {
   p.diffusion = Diffusion::none;
   p.viscosity = Viscosity::laminar;
   p.rheology = true;  // registers shear_stress, which the criterion reads
+  p.splitting = true; // registers split_fresh, which the relaxation after a split reads
   p.material_count = 3;
   for (int m = 0; m < 3; ++m) {
     p.materials[m].eos = TaitEos::make(m == 0 ? 1000.0 : kRho0, 30.0, 7.0, 0.0);
@@ -311,8 +313,30 @@ double summation_density(const World<2>& w, std::size_t i) {
   return rho;
 }
 
-TEST(Splitting, SummationDensityInsideASplitBlockIsTheMothers) {
-  // 40 x 40 lattice at uniform density (h = 2 dx); the 12 x 12 block in its middle splits.
+// Largest |rho_sum / rho_mother - 1| over the daughters (material 2) more than 2h0 from the split
+// block's edge (`deep`), over all daughters, and over the mothers' lattice within 2h0 of the block.
+struct Blip {
+  double deep = 0, daughters = 0, mothers = 0;
+};
+
+Blip summation_blip(const World<2>& w, double rho_mother) {
+  Blip b;
+  for (std::size_t i = 0; i < w.n(); ++i) {
+    const double dev = std::abs(summation_density(w, i) / rho_mother - 1.0);
+    const double from_edge = 0.06 - std::max(std::abs(double(w.x(i)[0]) - 0.2), std::abs(double(w.x(i)[1]) - 0.2));
+    if (w.material(i) != 2) {
+      if (from_edge > -2.0 * 2.0 * kDx) b.mothers = std::max(b.mothers, dev);
+      continue;
+    }
+    if (from_edge > 2.0 * 2.0 * kDx) b.deep = std::max(b.deep, dev);  // beyond the mothers' support
+    b.daughters = std::max(b.daughters, dev);
+  }
+  return b;
+}
+
+// Summation density sum_j m_j W(r_ij, (h_i + h_j)/2) on a 40 x 40 lattice at rest (h = 2 dx) whose
+// middle 12 x 12 block splits; reference: the mother's summation density before the split.
+TEST(Splitting, SummationDensityAfterASplitIsTheMothersWithin2Percent) {
   constexpr int n = 40;
   const auto inside = [](const Vec<2>& x) {
     return std::abs(x[0] - Real(0.2)) < Real(0.06) && std::abs(x[1] - Real(0.2)) < Real(0.06);
@@ -323,59 +347,52 @@ TEST(Splitting, SummationDensityInsideASplitBlockIsTheMothers) {
     w.s.data<Real>(w.ids.mass)[i] = Real(kRho0 * kDx * kDx);
     w.s.data<Real>(w.ids.shear_stress)[i] = Real(inside(w.x(i)) ? 500.0 : 0.0);
   }
-  // Reference: a mother at the block's centre before the split (the lattice sum at h = 2 dx).
   std::size_t centre = 0;
   for (std::size_t i = 0; i < w.n(); ++i)
     if (std::abs(w.x(i)[0] - Real(0.195)) < Real(1e-4) && std::abs(w.x(i)[1] - Real(0.195)) < Real(1e-4)) centre = i;
   const double rho_mother = summation_density(w, centre);
-  const SplitCounts c = w.be->split(one_rule(150.0, false));
+  const SplitParams rules = one_rule(150.0, false);
+  const SplitCounts c = w.be->split(rules);
   ASSERT_EQ(c.splits, 144u);
-  double deep = 0, edge_max = 0;
-  for (std::size_t i = 0; i < w.n(); ++i) {
-    if (w.material(i) != 2) continue;
-    const double dev = std::abs(summation_density(w, i) / rho_mother - 1.0);
-    const double from_edge = 0.06 - std::max(std::abs(double(w.x(i)[0]) - 0.2), std::abs(double(w.x(i)[1]) - 0.2));
-    if (from_edge > 2.0 * 2.0 * kDx) deep = std::max(deep, dev);  // beyond the mothers' support
-    edge_max = std::max(edge_max, dev);
-  }
-  std::printf("summation density after the split: deep daughters within %.3f%%, all daughters within %.2f%%\n",
-              100 * deep, 100 * edge_max);
+  const Blip raw = summation_blip(w, rho_mother);
   // Daughters among daughters form a lattice of dx/2 with h = dx, the mothers' lattice scaled by
   // one half, so their summation density is the mothers' (0.000% measured; bound 0.3%).
-  EXPECT_LT(deep, 0.003) << "daughters more than 2h from the block's edge";
-  // Open (transition issue): on the block's edge, where daughters meet mothers of twice their h,
-  // the kernel of the mean h gives up to 15.5% (the mean of both kernels 11%, the daughter's own h
-  // 4.8%, measured by the same sum); the issue asks 2%. Printed above, not asserted yet.
-}
-
-// The 3D edge's cube root is correctly rounded (so the CPU and the GPU agree to the bit), checked
-// exactly in integers: v = V 2^ev and r = R 2^er with 24-bit V and R; r is the nearest float to
-// cbrt(v) when (R - 1/2)^3 2^(3 er) < v < (R + 1/2)^3 2^(3 er), i.e. (2R -+ 1)^3 against
-// V 2^(ev - 3 er + 3), all below 2^124 for volumes between 1e-15 and 1e3.
-TEST(Splitting, CubeRootIsCorrectlyRounded) {
-  using i128 = __int128;
-  const auto mantissa = [](float x, int& e) {
-    const float f = std::frexp(x, &e);  // x = f 2^e, f in [0.5, 1)
-    e -= 24;
-    return std::int64_t(std::ldexp(f, 24));
-  };
-  std::size_t libm_differs = 0, checked = 0;
-  for (double v0 = 1e-15; v0 < 1e3; v0 *= 1.0001) {
-    const float v = float(v0);
-    const float r = cube_root_rn(v);
-    int ev = 0, er = 0;
-    const i128 V = mantissa(v, ev), R = mantissa(r, er);
-    const int shift = ev - 3 * er + 3;
-    ASSERT_TRUE(shift >= 0 && shift < 100) << v;  // about 51: 24-bit V against 72-bit R^3
-    const i128 lhs = V << shift;
-    const auto cube = [](i128 m) { return m * m * m; };
-    EXPECT_LT(cube(2 * R - 1), lhs) << "v = " << v << ", r = " << r;
-    EXPECT_GT(cube(2 * R + 1), lhs) << "v = " << v << ", r = " << r;
-    libm_differs += std::cbrt(v) != r ? 1 : 0;
-    ++checked;
+  EXPECT_LT(raw.deep, 0.003) << "daughters more than 2h from the block's edge";
+  // On the block's edge no symmetric pair kernel serves both sides (the mean h: daughters +15.5%,
+  // mothers 5.0%; the mean of both kernels 11% / 7%; docs/choices.md): the relaxation after the
+  // split moves the daughters and the particles within a pair support of them.
+  const Totals before = totals(w);
+  std::vector<Vec<2>> x0(w.n());
+  w.be->update_neighbours();  // as the time loop does after a split
+  for (std::size_t i = 0; i < w.n(); ++i) {
+    x0[w.id(i)] = w.x(i);
   }
-  std::printf("cube root: %zu volumes checked, libm's cbrtf differs from the correctly rounded root in %zu\n", checked,
-              libm_differs);
+  const std::size_t zone = w.be->relax_split(rules);
+  const Blip relaxed = summation_blip(w, rho_mother);
+  const Totals after = totals(w);
+  double moved = 0;
+  for (std::size_t i = 0; i < w.n(); ++i)
+    moved = std::max(moved, std::hypot(double(w.x(i)[0] - x0[w.id(i)][0]), double(w.x(i)[1] - x0[w.id(i)][1])));
+  std::printf("summation density after the split: daughters within %.2f%% (deep %.3f%%), mothers near the block %.2f%%;\n"
+              "after %d relaxation steps (%zu particles): daughters %.2f%%, mothers %.2f%%, largest shift %.3f dx\n",
+              100 * raw.daughters, 100 * raw.deep, 100 * raw.mothers, rules.relax_iterations, zone,
+              100 * relaxed.daughters, 100 * relaxed.mothers, moved / kDx);
+  EXPECT_GT(raw.daughters, 0.10) << "the blip the relaxation is for (15.5% measured)";
+  EXPECT_LT(relaxed.daughters, 0.02) << "the issue's bound: summation density at the daughters within 2%";
+  EXPECT_LT(relaxed.mothers, 0.02) << "and the mothers around them";
+  // Mothers closer than the pair support 1.5 h0 = 3 dx to a daughter: the daughters reach dx/4 past
+  // the block's edge mothers, so three rings (0.75, 1.75, 2.75 dx) along the 4 x 12 edge columns and
+  // 6 lattice points beyond each corner: 144 + 24.
+  EXPECT_EQ(zone, std::size_t(576 + 168)) << "the 576 daughters and the 168 mothers within a pair support of one";
+  EXPECT_LT(moved, 0.5 * 2.0 * kDx) << "at most 0.05 h per step for 10 steps";
+  // Positions only: each particle keeps its mass and velocity (the sums differ only in their order:
+  // the grid update sorted the particles), 1e-12 relative; the zone's mean shift is removed, so the
+  // centre of mass stays to the rounding of the stored float positions (half an ulp of 0.4 m).
+  EXPECT_NEAR(after.mass, before.mass, 1e-12 * before.mass);
+  EXPECT_NEAR(after.energy, before.energy, 1e-12 * before.energy);
+  for (int k = 0; k < 2; ++k)
+    EXPECT_NEAR(after.moment[k] / after.mass, before.moment[k] / before.mass, 0.5 * 0.4 * 6e-8)
+        << "centre of mass, axis " << k;
 }
 
 TEST(Splitting, DivideCarryNeedsFloatingPoint) {

@@ -110,6 +110,9 @@ class CpuBackend final : public Backend {
   SplitCounts split(const SplitParams& rules) override {
     return params_.dimensions == 2 ? split_impl<2>(rules) : split_impl<3>(rules);
   }
+  std::size_t relax_split(const SplitParams& rules) override {
+    return params_.dimensions == 2 ? relax_impl<2>(rules) : relax_impl<3>(rules);
+  }
 
   template <int D>
   std::vector<BodyLoad> loads_impl(const std::vector<std::array<double, 3>>& reference) {
@@ -138,6 +141,7 @@ class CpuBackend final : public Backend {
         parallel_for(n, SplitFlagPass<D, K, U>{P, G, params_, rules, new_slots_.data(), rule_of_.data()});
       });
     }
+    if (ids_.split_fresh >= 0) std::fill_n(store_->data<std::uint8_t>(ids_.split_fresh), n, std::uint8_t(0));
     std::exclusive_scan(new_slots_.begin(), new_slots_.end(), first_slot_.begin(), std::uint64_t(0));
     const std::uint64_t room = store_->capacity() - n;
     const Real* h = store_->data<Real>(ids_.smoothing_length);
@@ -159,6 +163,48 @@ class CpuBackend final : public Backend {
     list_valid_ = false;
     soa_valid_ = false;
     return c;
+  }
+
+  // The relaxation after a split (sph/splitting.hpp): zone, then Jacobi steps whose shifts read the
+  // positions of the step before; the zone's mass-weighted mean shift summed in double on one thread
+  // in index order (the same bits for every thread count). The grid is the one built after the
+  // split: the zone moves by well under a cell (at most 0.05 h per step).
+  template <int D>
+  std::size_t relax_impl(const SplitParams& rules) {
+    if (ids_.split_fresh < 0 || rules.relax_iterations <= 0) return 0;
+    const std::uint32_t n = std::uint32_t(store_->size());
+    relax_zone_.resize(n);
+    relax_shift_.resize(std::size_t(n) * D);
+    ParticleView<D> P = view<D>();
+    P.position_soa = nullptr;  // positions move during the relaxation: read them, not the sorted copy
+    const GridView<D> G = grid<D>();
+    auto* shift = reinterpret_cast<Vec<D>*>(relax_shift_.data());
+    std::size_t zone_count = 0;
+    dispatch_kernel<D>(params_, [&](auto kernel_tag, auto uniform_tag) {
+      using K = typename decltype(kernel_tag)::type;
+      constexpr bool U = decltype(uniform_tag)::value;
+      parallel_for(n, SplitRelaxZonePass<D, K, U>{P, G, params_, relax_zone_.data()});
+      double zone_mass = 0;
+      for (std::uint32_t i = 0; i < n; ++i)
+        if (relax_zone_[i]) {
+          ++zone_count;
+          zone_mass += double(P.mass[i]);
+        }
+      if (zone_count == 0) return;
+      for (int it = 0; it < rules.relax_iterations; ++it) {
+        parallel_for(n, SplitRelaxShiftPass<D, K, U>{P, G, params_, relax_zone_.data(), shift, rules.relax_strength});
+        double moment[D] = {};
+        for (std::uint32_t i = 0; i < n; ++i)
+          if (relax_zone_[i])
+            for (int a = 0; a < D; ++a) moment[a] += double(P.mass[i]) * double(shift[i][a]);
+        Vec<D> mean;
+        for (int a = 0; a < D; ++a) mean[a] = Real(moment[a] / zone_mass);
+        parallel_for(n, SplitRelaxApplyPass<D>{P, DriftPass<D>{P, Real(0), Real(0), params_}, relax_zone_.data(), shift, mean});
+      }
+    });
+    list_valid_ = false;
+    soa_valid_ = false;
+    return zone_count;
   }
 
   double max_h_ratio() const {
@@ -194,6 +240,7 @@ class CpuBackend final : public Backend {
     if (ids_.shear_rate >= 0) v.shear_rate = s.data<Real>(ids_.shear_rate);
     if (ids_.effective_viscosity >= 0) v.effective_viscosity = s.data<Real>(ids_.effective_viscosity);
     if (ids_.shear_stress >= 0) v.shear_stress = s.data<Real>(ids_.shear_stress);
+    if (ids_.split_fresh >= 0) v.split_fresh = s.data<std::uint8_t>(ids_.split_fresh);
     v.count = std::uint32_t(s.size());
     if (soa_valid_) {
       v.position_soa = soa_.data();
@@ -417,6 +464,8 @@ class CpuBackend final : public Backend {
   std::vector<std::uint32_t> new_slots_;  // splitting: slots each particle asks for
   std::vector<std::int8_t> rule_of_;      // splitting: the rule a particle meets, or -1
   std::vector<std::uint64_t> first_slot_; // splitting: exclusive scan of new_slots_
+  std::vector<std::uint8_t> relax_zone_;  // relaxation after a split: 1 for the particles it moves
+  std::vector<Real> relax_shift_;         // relaxation after a split: each zone particle's shift
   std::uint32_t list_stride_ = 0;
   bool list_valid_ = false;
   std::vector<Real> soa_;

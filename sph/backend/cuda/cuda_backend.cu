@@ -296,6 +296,9 @@ class CudaBackend final : public Backend {
   SplitCounts split(const SplitParams& rules) override {
     return params_.dimensions == 2 ? split_impl<2>(rules) : split_impl<3>(rules);
   }
+  std::size_t relax_split(const SplitParams& rules) override {
+    return params_.dimensions == 2 ? relax_impl<2>(rules) : relax_impl<3>(rules);
+  }
 
   template <int D>
   std::vector<BodyLoad> loads_impl(const std::vector<std::array<double, 3>>& reference) {
@@ -386,6 +389,7 @@ class CudaBackend final : public Backend {
     if (ids_.shear_rate >= 0) v.shear_rate = static_cast<Real*>(field(ids_.shear_rate));
     if (ids_.effective_viscosity >= 0) v.effective_viscosity = static_cast<Real*>(field(ids_.effective_viscosity));
     if (ids_.shear_stress >= 0) v.shear_stress = static_cast<Real*>(field(ids_.shear_stress));
+    if (ids_.split_fresh >= 0) v.split_fresh = static_cast<std::uint8_t*>(field(ids_.split_fresh));
     v.count = n_;
     return v;
   }
@@ -496,6 +500,8 @@ class CudaBackend final : public Backend {
     std::int8_t* rule_of = split_rule_.as<std::int8_t>();
     std::uint64_t* first = split_first_.as<std::uint64_t>();
     SplitTally* tally = split_tally_.as<SplitTally>();
+    if (ids_.split_fresh >= 0)  // the last split's daughters are old now
+      TURBID_CUDA_CHECK(cudaMemset(fields_[std::size_t(ids_.split_fresh)].get(), 0, n));
     const ParticleView<D> P = view<D>();
     const GridView<D> G = grid<D>();
     dispatch_kernel<D>(params_, [&](auto kernel_tag, auto uniform_tag) {
@@ -532,6 +538,43 @@ class CudaBackend final : public Backend {
     store_->resize(n_);  // within the capacity; the host's data follow at sync_to_host()
     c.daughters = t.added;
     return c;
+  }
+
+  // The relaxation after a split, as on the CPU (sph/splitting.hpp); the zone's mean shift is a
+  // CUB reduction in double (its last bits may differ from the CPU's ordered sum).
+  template <int D>
+  std::size_t relax_impl(const SplitParams& rules) {
+    if (ids_.split_fresh < 0 || rules.relax_iterations <= 0 || n_ == 0) return 0;
+    const std::uint32_t n = n_;
+    relax_zone_.ensure(capacity_ * sizeof(std::uint8_t));
+    relax_shift_.ensure(capacity_ * sizeof(Vec<D>));
+    relax_moment_.ensure(capacity_ * sizeof(RelaxMoment));
+    result_.ensure(sizeof(RelaxMoment));
+    std::uint8_t* zone = relax_zone_.as<std::uint8_t>();
+    Vec<D>* shift = relax_shift_.as<Vec<D>>();
+    RelaxMoment* moment = relax_moment_.as<RelaxMoment>();
+    const ParticleView<D> P = view<D>();
+    const GridView<D> G = grid<D>();
+    std::size_t zone_count = 0;
+    dispatch_kernel<D>(params_, [&](auto kernel_tag, auto uniform_tag) {
+      using K = typename decltype(kernel_tag)::type;
+      constexpr bool U = decltype(uniform_tag)::value;
+      launch("SplitRelaxZonePass", n, SplitRelaxZonePass<D, K, U>{P, G, params_, zone});
+      for (int it = 0; it < rules.relax_iterations; ++it) {
+        launch("SplitRelaxShiftPass", n, SplitRelaxShiftPass<D, K, U>{P, G, params_, zone, shift, rules.relax_strength});
+        launch("RelaxMomentPass", n, RelaxMomentPass<D>{zone, P.mass, shift, moment});
+        TURBID_CUB_CALL("cub::DeviceReduce::Reduce(relaxation moment)",
+                        cub::DeviceReduce::Reduce(cub_temp, cub_temp_bytes, moment, result_.as<RelaxMoment>(), n,
+                                                  SumRelaxMoment{}, RelaxMoment{0, 0, {0, 0, 0}}));
+        const RelaxMoment m = download_result<RelaxMoment>();
+        zone_count = std::size_t(m.count);
+        if (zone_count == 0) return;
+        Vec<D> mean;
+        for (int a = 0; a < D; ++a) mean[a] = Real(m.moment[a] / m.mass);
+        launch("SplitRelaxApplyPass", n, SplitRelaxApplyPass<D>{P, DriftPass<D>{P, Real(0), Real(0), params_}, zone, shift, mean});
+      }
+    });
+    return zone_count;
   }
 
   template <int D>
@@ -606,6 +649,7 @@ class CudaBackend final : public Backend {
   DeviceBuffer cell_start_, keys_in_, keys_out_, values_in_, values_out_;
   DeviceBuffer reduce_in_, result_, temp_;
   DeviceBuffer split_slots_, split_rule_, split_first_, split_tally_;  // splitting only, from the first split
+  DeviceBuffer relax_zone_, relax_shift_, relax_moment_;  // relaxation after a split, from the first one
 };
 
 #undef TURBID_CUB_CALL
