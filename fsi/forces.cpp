@@ -26,11 +26,29 @@ std::vector<std::string> force_columns(const Scene& scene) {
       cols.push_back(p + "C_D [-]");
       cols.push_back(p + "C_L [-]");
     }
+    if (st.motion != StructureSpec::Motion::fixed) {
+      const std::vector<std::string> axes = two_d ? std::vector<std::string>{"x", "y"}
+                                                  : std::vector<std::string>{"x", "y", "z"};
+      for (const auto& a : axes) cols.push_back(p + a + " [m]");
+      cols.push_back(p + "qw [-]");
+      if (!two_d) {
+        cols.push_back(p + "qx [-]");
+        cols.push_back(p + "qy [-]");
+      }
+      cols.push_back(p + "qz [-]");
+      for (const auto& a : axes) cols.push_back(p + "v" + a + " [m/s]");
+      if (!two_d) {
+        cols.push_back(p + "wx [rad/s]");
+        cols.push_back(p + "wy [rad/s]");
+      }
+      cols.push_back(p + "wz [rad/s]");
+    }
   }
   return cols;
 }
 
-std::vector<double> force_row(const Scene& scene, const std::vector<sph::BodyLoad>& loads) {
+std::vector<double> force_row(const Scene& scene, const std::vector<sph::BodyLoad>& loads,
+                              const std::vector<BodyKinematics>& kinematics) {
   if (loads.size() != scene.structures.size())
     throw std::logic_error("force_row: one load per structure expected");
   const bool two_d = scene.dimensions == 2;
@@ -58,6 +76,25 @@ std::vector<double> force_row(const Scene& scene, const std::vector<sph::BodyLoa
       row.push_back(lift);
       row.push_back(drag / q);
       row.push_back(lift / q);
+    }
+    if (st.motion != StructureSpec::Motion::fixed) {
+      if (kinematics.size() != loads.size())
+        throw std::logic_error("force_row: one body state per structure expected for moving structures");
+      const BodyKinematics& b = kinematics[k];
+      const int n = two_d ? 2 : 3;
+      for (int a = 0; a < n; ++a) row.push_back(b.position[std::size_t(a)]);
+      row.push_back(b.orientation[0]);
+      if (!two_d) {
+        row.push_back(b.orientation[1]);
+        row.push_back(b.orientation[2]);
+      }
+      row.push_back(b.orientation[3]);
+      for (int a = 0; a < n; ++a) row.push_back(b.velocity[std::size_t(a)]);
+      if (!two_d) {
+        row.push_back(b.angular_velocity[0]);
+        row.push_back(b.angular_velocity[1]);
+      }
+      row.push_back(b.angular_velocity[2]);
     }
   }
   return row;

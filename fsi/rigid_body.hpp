@@ -102,6 +102,15 @@ class RigidBody {
   void set_velocity(const Eigen::Vector3d& v);
   void set_angular_velocity(const Eigen::Vector3d& w);
 
+  // The exact state as saved (checkpoints): no normalisation, no projection onto the locks.
+  void restore_state(const Eigen::Vector3d& x, const Eigen::Quaterniond& q, const Eigen::Vector3d& v,
+                     const Eigen::Vector3d& L) {
+    x_ = x;
+    q_ = q;
+    v_ = v;
+    L_ = L;
+  }
+
   // World position of a body-frame point (relative to the centre, body axes) and the velocity of
   // the body at a world point.
   Eigen::Vector3d to_world(const Eigen::Vector3d& body_point) const { return x_ + q_ * body_point; }

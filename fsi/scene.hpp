@@ -103,10 +103,12 @@ struct WallSpec {
   SourceLocation where;
 };
 
-// A structure: a solid sampled into boundary particles (kind structure), fixed in this version.
-// The fluid force on it is reported in forces.csv.
+// A structure: a solid sampled into boundary particles (kind structure), fixed or free (the built-in
+// rigid-body integrator, fsi/rigid_body.hpp, coupled to the fluid by fsi/body_coupling.hpp). The
+// fluid force on it is reported in forces.csv.
 struct StructureSpec {
   enum class Shape { box, sphere, cylinder, mesh };
+  enum class Motion { fixed, free };
   std::string name;
   Shape shape = Shape::box;
   Vec3d size{0, 0, 0};      // box: extents [m]
@@ -129,6 +131,20 @@ struct StructureSpec {
   double reference_density = 0;   // [kg/m^3]
   double reference_length = 0;    // [m]
   double reference_area = 0;      // [m^2] (3D)
+  // motion: free. Mass properties from the solid's filled sampling at the scene's spacing and
+  // `density`, or from `mass` (then a uniform density mass / volume for the defaults); an explicit
+  // centre of mass and inertia tensor replace the sampled ones. A free body's torques (forces.csv)
+  // are about its moving centre of mass.
+  Motion motion = Motion::fixed;
+  double density = 0;              // [kg/m^3]; 0 = not given
+  double mass = 0;                 // [kg] (2D: kg/m); 0 = not given
+  bool has_centre_of_mass = false;
+  Vec3d centre_of_mass{0, 0, 0};   // [m]
+  bool has_inertia = false;
+  // About the centre of mass, world axes at t = 0, row-major [kg m^2] (2D: only I_zz, [kg m^2/m])
+  std::array<double, 9> inertia{0, 0, 0, 0, 0, 0, 0, 0, 0};
+  std::array<bool, 3> lock_translation{false, false, false};  // x, y, z locked
+  std::array<bool, 3> lock_rotation{false, false, false};     // rx, ry, rz locked
   SourceLocation where;
 };
 

@@ -256,6 +256,34 @@ geometry::SampledBody sample_structure(const StructureSpec& st, double dx, int d
   return {};
 }
 
+MassProperties mass_properties_of(const Scene& scene, const StructureSpec& st, const geometry::TriangleMesh* mesh) {
+  const int d = scene.dimensions;
+  const geometry::SampledBody filled = sample_structure(st, scene.particle_spacing, d, 0, mesh);
+  double volume = 0;
+  for (double v : filled.volumes) volume += v;
+  if (!(volume > 0)) throw std::invalid_argument("its filled sampling has no volume at this particle spacing");
+  const double density = st.density > 0 ? st.density : st.mass / volume;
+  MassProperties mp = mass_properties(filled, density, d);
+  if (st.mass > 0) mp.mass = st.mass;
+  if (st.has_centre_of_mass) {
+    // The sampled inertia is about the sampled centre; move it to the given one (parallel axes).
+    const Eigen::Vector3d c(st.centre_of_mass[0], st.centre_of_mass[1], d == 3 ? st.centre_of_mass[2] : 0.0);
+    const Eigen::Vector3d r = c - mp.centre_of_mass;
+    mp.inertia += mp.mass * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
+    mp.centre_of_mass = c;
+  }
+  if (st.has_inertia) {
+    if (d == 2) {
+      // Only I_zz enters planar motion; the lamina's other moments keep their sampled proportions.
+      mp.inertia *= st.inertia[8] / mp.inertia(2, 2);
+    } else {
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) mp.inertia(a, b) = st.inertia[std::size_t(3 * a + b)];
+    }
+  }
+  return mp;
+}
+
 // The solid of a structure, for its exact signed distance (geometry/solid.hpp).
 geometry::Solid structure_solid(const StructureSpec& st, int dims, const geometry::TriangleMesh* mesh) {
   const geometry::Placement place = placement_of(st);
@@ -473,9 +501,20 @@ sph::PhysicsParams physics_params(const Scene& scene) {
   return p;
 }
 
+bool has_free_structures(const Scene& scene) {
+  for (const auto& st : scene.structures)
+    if (st.motion == StructureSpec::Motion::free) return true;
+  return false;
+}
+
+MassProperties structure_mass_properties(const Scene& scene, const StructureSpec& st) {
+  return mass_properties_of(scene, st, nullptr);
+}
+
 Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::move(scene)) {
   params_ = physics_params(scene_);
-  ids_ = sph::register_fields(store_, params_, !scene_.structures.empty());
+  const bool free_bodies = has_free_structures(scene_);
+  ids_ = sph::register_fields(store_, params_, !scene_.structures.empty(), free_bodies);
   build_particles();
 
   std::unique_ptr<sph::Backend> backend;
@@ -486,13 +525,17 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
   } else if (options.backend == "auto") {
     std::string why;
     backend = sph::cuda_device_count(&why) > 0 ? sph::make_cuda_backend() : sph::make_cpu_backend(options.threads);
-    // A backend without splitting hands a scene with transitions to the CPU.
+    // A backend without splitting (or moving bodies) hands the scene to the CPU.
     if (!scene_.transitions.empty() && !backend->supports_splitting()) backend = sph::make_cpu_backend(options.threads);
+    if (free_bodies && !backend->supports_moving_bodies()) backend = sph::make_cpu_backend(options.threads);
   } else {
     throw std::invalid_argument("unknown backend '" + options.backend + "' (expected auto, cpu or cuda)");
   }
   if (!scene_.transitions.empty() && !backend->supports_splitting())
     throw std::invalid_argument("the scene has transitions (particle splitting), which the " + backend->name() +
+                                " backend does not run yet; use --backend cpu (or auto)");
+  if (free_bodies && !backend->supports_moving_bodies())
+    throw std::invalid_argument("the scene has free structures (motion: free), which the " + backend->name() +
                                 " backend does not run yet; use --backend cpu (or auto)");
   backend_name_ = backend->name();
   threads_ = backend->threads();
@@ -503,6 +546,31 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
   tp.density_ratio_limit = scene_.numerics.density_ratio_limit;
   solver_ = std::make_unique<sph::Solver>(store_, ids_, params_, summary_.domain, tp, std::move(backend));
   if (!scene_.transitions.empty()) solver_->set_splitting(split_params(scene_), scene_.capacity.error_when_full);
+  if (free_bodies) {
+    std::vector<std::optional<RigidBody>> rigid(scene_.structures.size());
+    for (const auto& fb : summary_.free_bodies) {
+      const StructureSpec& st = scene_.structures[fb.structure];
+      DofMask mask;
+      for (std::size_t a = 0; a < 3; ++a) {
+        mask.translation[a] = !st.lock_translation[a];
+        mask.rotation[a] = !st.lock_rotation[a];
+      }
+      try {
+        rigid[fb.structure].emplace(fb.mass_properties, mask);
+      } catch (const std::exception& e) {
+        std::ostringstream os;
+        os << st.where.file << ":" << st.where.line << ":" << st.where.column << ": error: structure '" << st.name
+           << "': " << e.what();
+        throw std::invalid_argument(os.str());
+      }
+    }
+    const Eigen::Vector3d g(scene_.gravity[0], scene_.gravity[1], scene_.dimensions == 3 ? scene_.gravity[2] : 0.0);
+    bodies_ = std::make_unique<BodyCoupling>(std::move(rigid), g);
+    solver_->set_coupling(bodies_.get());
+    // The particles were written at their sampled positions; the placement rounds x_c + R r0 once,
+    // as every later step does, so the first step starts from the same kind of positions.
+    bodies_->place(solver_->backend(), true);
+  }
 }
 
 sph::SplitParams split_params(const Scene& scene) {
@@ -553,6 +621,7 @@ void Simulation::build_particles() {
     Point velocity{0, 0, 0};
     std::uint8_t zone = sph::kNoZone;
     bool free_slip = false;          // a particle of a free-slip wall
+    Point offset{0, 0, 0};           // moving structures: position relative to the centre of mass
   };
   std::vector<Item> items;
   summary_.particles_per_material.assign(s.materials.size(), 0);
@@ -579,6 +648,8 @@ void Simulation::build_particles() {
       const geometry::TriangleMesh* m = st.shape == StructureSpec::Shape::mesh ? &mesh : nullptr;
       bodies.push_back(sample_structure(st, dx, d, layers, m));
       solids.push_back(structure_solid(st, d, m));
+      if (st.motion == StructureSpec::Motion::free)
+        summary_.free_bodies.push_back({bodies.size() - 1, st.name, mass_properties_of(s, st, m)});
     } catch (const std::exception& e) {
       std::ostringstream os;
       os << st.where.file << ":" << st.where.line << ":" << st.where.column << ": error: structure '" << st.name
@@ -729,6 +800,10 @@ void Simulation::build_particles() {
   summary_.wall_particles = items.size() - summary_.fluid_particles;
   for (std::size_t b = 0; b < bodies.size(); ++b) {
     const auto& body = bodies[b];
+    Point centre{0, 0, 0};
+    for (const auto& fb : summary_.free_bodies)
+      if (fb.structure == b)
+        for (int k = 0; k < 3; ++k) centre[std::size_t(k)] = fb.mass_properties.centre_of_mass[k];
     for (std::size_t i = 0; i < body.points.size(); ++i) {
       const Point& x = body.points[i];
       const double depth = std::isfinite(global_top) ? std::max(0.0, global_top - height_of(s, x)) : 0.0;
@@ -736,6 +811,7 @@ void Simulation::build_particles() {
                         d == 3 ? 2 * body.depth[i] * body.normals[i][2] : 0.0};
       items.push_back({x, wall_eos.hydrostatic_density(g, depth), 0, sph::Kind::structure, ghost, std::uint8_t(b),
                        body.volumes[i]});
+      for (std::size_t k = 0; k < 3; ++k) items.back().offset[k] = x[k] - centre[k];
     }
   }
   summary_.structure_particles = items.size() - summary_.fluid_particles - summary_.wall_particles;
@@ -804,7 +880,14 @@ void Simulation::build_particles() {
   auto* zone = ids_.zone >= 0 ? store_.data<std::uint8_t>(ids_.zone) : nullptr;
   auto* slip = ids_.free_slip >= 0 ? store_.data<std::uint8_t>(ids_.free_slip) : nullptr;
   auto* vel = static_cast<sph::Real*>(store_.raw(ids_.velocity));
+  auto* offset = ids_.body_offset >= 0 ? static_cast<sph::Real*>(store_.raw(ids_.body_offset)) : nullptr;
+  auto* normal0 = ids_.body_normal >= 0 ? static_cast<sph::Real*>(store_.raw(ids_.body_normal)) : nullptr;
   for (std::size_t i = 0; i < items.size(); ++i) {
+    // The body frame is the world's axes at t = 0 (rigid_body.hpp): r0 = p0 - x0, n0 = n.
+    if (offset)
+      for (int k = 0; k < d; ++k) offset[i * std::size_t(d) + std::size_t(k)] = sph::Real(items[i].offset[k]);
+    if (normal0)
+      for (int k = 0; k < d; ++k) normal0[i * std::size_t(d) + std::size_t(k)] = sph::Real(items[i].ghost[k]);
     for (int k = 0; k < d; ++k) x[i * std::size_t(d) + std::size_t(k)] = sph::Real(items[i].x[k]);
     if (ghost)
       for (int k = 0; k < d; ++k) ghost[i * std::size_t(d) + std::size_t(k)] = sph::Real(items[i].ghost[k]);
@@ -851,7 +934,29 @@ void Simulation::step() {
 std::vector<sph::BodyLoad> Simulation::structure_loads() {
   std::vector<std::array<double, 3>> reference;
   for (const auto& st : scene_.structures) reference.push_back(st.reference_point);
+  if (bodies_)
+    for (std::size_t k = 0; k < reference.size(); ++k)
+      if (bodies_->is_free(k))
+        for (int a = 0; a < 3; ++a) reference[k][std::size_t(a)] = bodies_->body(k).position()[a];
   return solver_->backend().body_loads(reference);
+}
+
+std::vector<BodyKinematics> Simulation::body_kinematics() const {
+  std::vector<BodyKinematics> out(scene_.structures.size());
+  if (!bodies_) return out;
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    if (!bodies_->is_free(k)) continue;
+    const RigidBody& b = bodies_->body(k);
+    const Eigen::Vector3d w = b.angular_velocity();
+    const Eigen::Quaterniond& q = b.orientation();
+    out[k].orientation = {q.w(), q.x(), q.y(), q.z()};
+    for (int a = 0; a < 3; ++a) {
+      out[k].position[std::size_t(a)] = b.position()[a];
+      out[k].velocity[std::size_t(a)] = b.velocity()[a];
+      out[k].angular_velocity[std::size_t(a)] = w[a];
+    }
+  }
+  return out;
 }
 
 std::vector<double> Simulation::probe_values() {

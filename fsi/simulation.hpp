@@ -6,6 +6,9 @@
 #include <string>
 #include <vector>
 
+#include "fsi/body_coupling.hpp"
+#include "fsi/forces.hpp"
+#include "fsi/mass_properties.hpp"
 #include "fsi/scene.hpp"
 #include "sph/backend.hpp"
 #include "sph/fields.hpp"
@@ -27,6 +30,13 @@ struct StructureSummary {
   double volume = 0;        // of the sampled solid [m^3] (area [m^2] in 2D)
 };
 
+// A free structure's mass properties as the run uses them (sampled or from the scene).
+struct FreeBodySummary {
+  std::size_t structure = 0;  // index in scene.structures
+  std::string name;
+  MassProperties mass_properties;
+};
+
 // Counts and derived values a user sees in `turbid check` and run.json.
 struct WorldSummary {
   std::size_t fluid_particles = 0;
@@ -36,6 +46,7 @@ struct WorldSummary {
   std::size_t fluid_removed_by_structures = 0;  // fluid lattice points inside or touching a structure
   double fluid_volume_restored = 0;  // the part of their cells outside the structures, given to neighbours [m^d]
   std::vector<StructureSummary> structures;
+  std::vector<FreeBodySummary> free_bodies;
   std::vector<std::size_t> particles_per_material;
   double smoothing_length = 0;     // [m]
   std::vector<double> sound_speed; // per material [m/s]
@@ -55,6 +66,12 @@ class Observer {
   virtual void on_forces(Simulation&) {}          // every forces interval (scenes with structures)
   virtual void on_finish(Simulation&) {}
 };
+
+// The mass properties of a free structure: from its filled sampling at the scene's spacing and its
+// density (or mass / sampled volume), with the scene's centre of mass (the sampled inertia moved to
+// it by the parallel-axis theorem) and inertia where given. Throws std::invalid_argument.
+MassProperties structure_mass_properties(const Scene& scene, const StructureSpec& st);
+bool has_free_structures(const Scene& scene);
 
 // Resolves scene defaults (automatic sound speed, wall layers) and converts to engine parameters.
 sph::PhysicsParams physics_params(const Scene& scene);
@@ -113,7 +130,13 @@ class Simulation {
 
   std::vector<double> probe_values();  // evaluated now (synchronises the store)
   // Force and torque of the fluid on every structure (scene order), from the last force pass.
+  // Free structures: torque about the body's current centre of mass.
   std::vector<sph::BodyLoad> structure_loads();
+  // One per structure (forces.csv); zeros for fixed ones.
+  std::vector<BodyKinematics> body_kinematics() const;
+  // The rigid bodies of the free structures; nullptr when every structure is fixed.
+  const BodyCoupling* bodies() const { return bodies_.get(); }
+  BodyCoupling* bodies() { return bodies_.get(); }
   std::uint64_t forces_index() const { return forces_index_; }
   void sync_to_host() { solver_->backend().sync_to_host(); }
 
@@ -125,6 +148,7 @@ class Simulation {
   sph::ParticleStore store_;
   sph::FieldIds ids_;
   WorldSummary summary_;
+  std::unique_ptr<BodyCoupling> bodies_;  // before solver_: the solver points at it
   std::unique_ptr<sph::Solver> solver_;
   std::string backend_name_;
   int threads_ = 1;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "sph/body_loads.hpp"
+#include "sph/body_motion.hpp"
 #include "sph/fields.hpp"
 #include "sph/grid_layout.hpp"
 #include "sph/open_boundary.hpp"
@@ -59,6 +60,12 @@ class Backend {
   // Force and torque of the fluid on each structure, from the last force pass (the exact reaction
   // of the fluid's accelerations); reference[k] is the point structure k's torque is taken about.
   virtual std::vector<BodyLoad> body_loads(const std::vector<std::array<double, 3>>& reference) = 0;
+  // Moves the particles of every structure with bodies[k].moving rigidly with it and gives them its
+  // velocity (sph/body_motion.hpp); needs the fields body_offset (and body_normal with mDBC). A
+  // backend that cannot throws std::runtime_error; supports_moving_bodies says so beforehand.
+  // move false: velocities only (the bodies were kicked, not drifted).
+  virtual void place_bodies(const std::vector<BodyPlacement>& bodies, bool move);
+  virtual bool supports_moving_bodies() const { return false; }
   // Splits the fluid particles that meet a rule (sph/splitting.hpp: flag, exclusive scan, ordered
   // writes; mothers beyond the store's capacity are refused). Reads the shear stress of the last
   // force pass. Afterwards the grid is stale: the caller updates neighbours and forces.

@@ -125,7 +125,7 @@ TURBID_HD inline Real ghost_interpolation(const ParticleView<D>& P, const GridVi
 // 2 v_wall - v~_g, v~_g the fluid velocity at the ghost node, so that it goes through v_wall at the
 // wall surface (English et al. 2022; Adami et al. 2012, C6); continuity keeps the wall's own
 // velocity (mirroring the normal component there doubled the compression in front of a cylinder
-// and let fluid through). Fixed walls: v_wall = 0.
+// and let fluid through). Fixed walls: v_wall = 0; moving structures carry their rigid velocity.
 template <int D, class K, bool UniformH>
 struct MdbcPass {
   ParticleView<D> P;
@@ -148,7 +148,8 @@ struct MdbcPass {
     }
     const Real rho_min = prm.materials[prm.wall_material].eos.no_tension_density();
     P.density[b] = rho > rho_min ? rho : rho_min;
-    if (no_slip) P.viscous_velocity[b] = Real(-1) * v_ghost;
+    // 2 v_wall - v~_g; a fixed wall has v_wall = 0, a moving structure its rigid velocity.
+    if (no_slip) P.viscous_velocity[b] = Real(2) * P.velocity[b] - v_ghost;
   }
 };
 

@@ -3,7 +3,7 @@
 
 namespace turbid::sph {
 
-FieldIds register_fields(ParticleStore& s, const PhysicsParams& p, bool structures) {
+FieldIds register_fields(ParticleStore& s, const PhysicsParams& p, bool structures, bool moving_bodies) {
   const int d = p.dimensions;
   // 2D runs are per metre of depth: mass is then kg/m and volumes m^2.
   const char* mass_unit = d == 2 ? "kg/m" : "kg";
@@ -35,6 +35,13 @@ FieldIds register_fields(ParticleStore& s, const PhysicsParams& p, bool structur
     const char* force_unit = d == 2 ? "N/m" : "N";
     f.body = s.add_field({"body", "", ScalarType::u8, 1, true, true, true, Carry::copy});
     f.structure_force = s.add_field({"structure_force", force_unit, ScalarType::f32, d, true, false, false, Carry::recompute});
+  }
+  // Set once when the world is built; the placement reads them, so they follow the sort and are
+  // checkpointed (they cannot be recomputed from rounded positions bit for bit).
+  if (structures && moving_bodies) {
+    f.body_offset = s.add_field({"body_offset", "m", ScalarType::f32, d, false, true, true, Carry::copy});
+    if (p.boundary == Boundary::mdbc)
+      f.body_normal = s.add_field({"body_normal", "m", ScalarType::f32, d, false, true, true, Carry::copy});
   }
   // Computed by the momentum pass after each sort and used by the next drift, like the
   // acceleration by the next half-kick: checkpointed for a bit-identical resume.

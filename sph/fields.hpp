@@ -13,6 +13,10 @@ struct FieldIds {
   FieldId boundary_normal = -1;   // registered only for mDBC
   FieldId viscous_velocity = -1;  // registered only for no-slip mDBC
   FieldId body = -1, structure_force = -1;  // registered only when the scene has structures
+  // Only when the scene has moving bodies: each body particle's position relative to its body's
+  // centre of mass in the body frame, and (mDBC) its ghost offset in the body frame; the placement
+  // after each drift rotates them into the world (sph/body_motion.hpp).
+  FieldId body_offset = -1, body_normal = -1;
   FieldId zone = -1;                        // registered only with open boundaries
   FieldId free_slip = -1;                   // registered only with free-slip walls (1: the particle's wall slips)
   FieldId shifting_velocity = -1;           // registered only with particle shifting
@@ -22,6 +26,8 @@ struct FieldIds {
 
 // Registers what `params` needs (a water-only run with Fourtakas diffusion gets no gradient field).
 // `structures`: the scene has structures (body index and per-particle force fields).
-FieldIds register_fields(ParticleStore& store, const PhysicsParams& params, bool structures = false);
+// `moving_bodies`: some structure moves (body_offset, and body_normal with mDBC).
+FieldIds register_fields(ParticleStore& store, const PhysicsParams& params, bool structures = false,
+                         bool moving_bodies = false);
 
 }  // namespace turbid::sph

@@ -33,6 +33,7 @@ Solver::Solver(ParticleStore& store, const FieldIds& ids, const PhysicsParams& p
 void Solver::start() {
   removed_ += backend_->update_neighbours();
   backend_->compute_forces();
+  if (coupling_) coupling_->after_forces(*backend_);
   check("the initial state, step");
 }
 
@@ -61,8 +62,10 @@ void Solver::step(double dt) {
     throw BlowUp(os.str());
   }
   backend_->kick(0.5 * dt);
+  if (coupling_) coupling_->after_kick(*backend_, 0.5 * dt);
   backend_->compute_density_rate();
   backend_->drift(dt);
+  if (coupling_) coupling_->after_drift(*backend_, dt);
   if (params_.zone_count > 0) {
     const OpenBoundaryCounts c = backend_->update_open_boundaries();
     inflow_ += c.inflow;
@@ -70,7 +73,9 @@ void Solver::step(double dt) {
   }
   removed_ += backend_->update_neighbours();
   backend_->compute_forces();
+  if (coupling_) coupling_->after_forces(*backend_);
   backend_->kick(0.5 * dt);
+  if (coupling_) coupling_->after_kick(*backend_, 0.5 * dt);
   time_ += dt;
   last_dt_ = dt;
   ++steps_;
@@ -101,6 +106,7 @@ void Solver::split() {
     removed_ += backend_->update_neighbours();
     if (split_.relax_iterations > 0 && backend_->relax_split(split_) > 0) removed_ += backend_->update_neighbours();
     backend_->compute_forces();
+    if (coupling_) coupling_->after_forces(*backend_);
     check("the split after step");
   }
   if (c.refused > 0 && split_error_when_full_) {

@@ -39,6 +39,17 @@ struct BlowUp : std::runtime_error {
 // number, and the viscous limit factor * h^2 / nu for laminar viscosity.
 double stable_time_step(const PhysicsParams& p, const TimeStepParams& t, double max_speed, double max_acceleration);
 
+// Something integrated in step with the fluid (fsi's rigid bodies): called inside Solver::step at
+// the points of the kick-drift-kick scheme, after the fluid's own kick, drift and force pass, with
+// the backend that holds the particles. The fluid knows nothing else about it.
+class StepCoupling {
+ public:
+  virtual ~StepCoupling() = default;
+  virtual void after_kick(Backend& backend, double half_dt) = 0;
+  virtual void after_drift(Backend& backend, double dt) = 0;
+  virtual void after_forces(Backend& backend) = 0;  // also after the force pass at the start
+};
+
 class Solver {
  public:
   Solver(ParticleStore& store, const FieldIds& ids, const PhysicsParams& params, const Domain& domain,
@@ -78,6 +89,8 @@ class Solver {
     split_totals_ = c;
     if (c.smallest_h > 0) lower_daughter_h(c.smallest_h);
   }
+  // Not owned; must outlive the solver. nullptr: none (the default, nothing is called).
+  void set_coupling(StepCoupling* coupling) { coupling_ = coupling; }
   Backend& backend() { return *backend_; }
   const PhysicsParams& params() const { return params_; }
 
@@ -91,6 +104,7 @@ class Solver {
   PhysicsParams params_;
   TimeStepParams time_params_;
   std::unique_ptr<Backend> backend_;
+  StepCoupling* coupling_ = nullptr;
   SplitParams split_;
   bool split_error_when_full_ = false;
   SplitCounts split_totals_;

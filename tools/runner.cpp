@@ -59,6 +59,52 @@ std::vector<double> fluid_momentum(const fsi::Simulation& sim) {
   return p;
 }
 
+// Free bodies' exact state for a checkpoint: position, orientation, velocity, angular momentum and
+// the fluid load of the last force pass (the first kick after a resume needs it), as JSON numbers,
+// which nlohmann writes with enough digits to read back the same doubles.
+nlohmann::json body_states(const fsi::Simulation& sim) {
+  nlohmann::json list = nlohmann::json::array();
+  const fsi::BodyCoupling& c = *sim.bodies();
+  const auto vec = [](const Eigen::Vector3d& v) { return nlohmann::json::array({v[0], v[1], v[2]}); };
+  for (std::size_t k = 0; k < c.structure_count(); ++k) {
+    if (!c.is_free(k)) continue;
+    const fsi::RigidBody& b = c.body(k);
+    const Eigen::Quaterniond& q = b.orientation();
+    list.push_back({{"structure", sim.scene().structures[k].name},
+                    {"position", vec(b.position())},
+                    {"orientation", nlohmann::json::array({q.w(), q.x(), q.y(), q.z()})},
+                    {"velocity", vec(b.velocity())},
+                    {"angular_momentum", vec(b.angular_momentum())},
+                    {"fluid_force", vec(c.fluid_load(k).force)},
+                    {"fluid_torque", vec(c.fluid_load(k).torque)}});
+  }
+  return list;
+}
+
+void restore_body_states(fsi::Simulation& sim, const nlohmann::json& state, const std::filesystem::path& dir) {
+  if (!sim.bodies()) return;
+  fsi::BodyCoupling& c = *sim.bodies();
+  if (!state.contains("bodies"))
+    throw std::runtime_error(dir.string() + ": the checkpoint has no rigid-body states, but the scene has free structures");
+  const auto vec = [](const nlohmann::json& j) { return Eigen::Vector3d(j.at(0), j.at(1), j.at(2)); };
+  for (std::size_t k = 0; k < c.structure_count(); ++k) {
+    if (!c.is_free(k)) continue;
+    const std::string& name = sim.scene().structures[k].name;
+    const nlohmann::json* found = nullptr;
+    for (const auto& b : state.at("bodies"))
+      if (b.at("structure").get<std::string>() == name) found = &b;
+    if (!found) throw std::runtime_error(dir.string() + ": the checkpoint has no state for free structure '" + name + "'");
+    const nlohmann::json& b = *found;
+    const auto& q = b.at("orientation");
+    c.body(k).restore_state(vec(b.at("position")), Eigen::Quaterniond(q.at(0), q.at(1), q.at(2), q.at(3)),
+                            vec(b.at("velocity")), vec(b.at("angular_momentum")));
+    fsi::Wrench w;
+    w.force = vec(b.at("fluid_force"));
+    w.torque = vec(b.at("fluid_torque"));
+    c.restore_fluid_load(k, w);
+  }
+}
+
 // Mass and particle count of each material's fluid particles (scene order).
 struct MaterialTotals {
   std::vector<double> mass;
@@ -100,7 +146,7 @@ class Writers final : public fsi::Observer {
   }
 
   void on_forces(fsi::Simulation& sim) override {
-    if (forces_) forces_->append(sim.time(), fsi::force_row(sim.scene(), sim.structure_loads()));
+    if (forces_) forces_->append(sim.time(), fsi::force_row(sim.scene(), sim.structure_loads(), sim.body_kinematics()));
   }
 
   void on_checkpoint(fsi::Simulation& sim) override { save_checkpoint(sim); }
@@ -159,6 +205,7 @@ class Writers final : public fsi::Observer {
     state["end_time"] = sim.scene().end_time;
     // Meshes named relative to the scene file are found from here when the run is resumed.
     state["scene_directory"] = sim.scene().base_directory;
+    if (sim.bodies()) state["bodies"] = body_states(sim);
     write_checkpoint(out_ / "checkpoint", sim.store(), state);
   }
 
@@ -226,6 +273,32 @@ std::string describe_scene(const fsi::Scene& scene) {
     os << "  structure " << st.name << ": " << st.particles << " particles, surface "
        << st.surface_area << (two_d ? " m (perimeter)" : " m^2") << ", volume " << st.volume
        << (two_d ? " m^2 (area)" : " m^3") << "\n";
+  for (const auto& fb : s.free_bodies) {
+    const auto& mp = fb.mass_properties;
+    const auto& st = scene.structures[fb.structure];
+    os << "  free body " << fb.name << ": mass " << mp.mass << (two_d ? " kg/m" : " kg") << ", centre of mass ("
+       << mp.centre_of_mass[0] << ", " << mp.centre_of_mass[1];
+    if (!two_d) os << ", " << mp.centre_of_mass[2];
+    os << ") m";
+    if (two_d) {
+      os << ", inertia I_zz " << mp.inertia(2, 2) << " kg m^2/m";
+    } else {
+      os << ", inertia [[" << mp.inertia(0, 0) << ", " << mp.inertia(0, 1) << ", " << mp.inertia(0, 2) << "], ["
+         << mp.inertia(1, 0) << ", " << mp.inertia(1, 1) << ", " << mp.inertia(1, 2) << "], [" << mp.inertia(2, 0)
+         << ", " << mp.inertia(2, 1) << ", " << mp.inertia(2, 2) << "]] kg m^2";
+    }
+    if (st.density > 0) os << " (density " << st.density << " kg/m^3";
+    else os << " (given mass";
+    os << (st.has_centre_of_mass ? ", given centre" : "") << (st.has_inertia ? ", given inertia" : "") << ")";
+    std::string locks;
+    for (int a = 0; a < 3; ++a) {
+      if (st.lock_translation[std::size_t(a)]) locks += std::string(locks.empty() ? "" : ", ") + "xyz"[a];
+    }
+    for (int a = 0; a < 3; ++a)
+      if (st.lock_rotation[std::size_t(a)]) locks += std::string(locks.empty() ? "" : ", ") + "r" + "xyz"[a];
+    if (!locks.empty()) os << ", locked " << locks;
+    os << "\n";
+  }
   for (const auto& ob : scene.open_boundaries)
     os << "  " << (ob.inlet ? "inlet " : "outlet ") << ob.name << ": flow along "
        << (ob.velocity.sign > 0 ? "+" : "-") << "xyz"[ob.velocity.axis]
@@ -363,6 +436,7 @@ nlohmann::json run_scene(const RunRequest& request) {
       splits.refused = state.value("splits_refused", std::size_t(0));
       splits.smallest_h = state.value("smallest_smoothing_length", 0.0);
       sim.restore_split_totals(splits);
+      restore_body_states(sim, state, *request.resume / "checkpoint");
     } else {
       sim.start();
     }

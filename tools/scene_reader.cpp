@@ -375,6 +375,7 @@ class Reader {
   void read_walls(const Value& v, fsi::Scene& scene, std::vector<YAML::Mark>& wall_marks) const;
   void read_fluids(const Value& v, fsi::Scene& scene, const std::vector<YAML::Mark>& wall_marks) const;
   void read_structures(const Value& v, fsi::Scene& scene) const;
+  void read_motion(const MapView& m, int dims, fsi::StructureSpec& st) const;
   void read_open_boundaries(const Value& v, fsi::Scene& scene) const;
   void read_probes(const Value& v, fsi::Scene& scene) const;
   void read_output(const Value& v, fsi::OutputSpec& out) const;
@@ -881,7 +882,7 @@ void Reader::read_structures(const Value& v, fsi::Scene& scene) const {
   for (const Value& item : list(v)) {
     MapView m(*this, item,
               {"name", "box", "sphere", "cylinder", "mesh", "position", "rotation", "scale", "layers",
-               "reference_point", "coefficients"});
+               "reference_point", "coefficients", "motion", "density", "mass", "centre_of_mass", "inertia", "lock"});
     fsi::StructureSpec st;
     st.where = where(item.mark);
     const Value nv = m.need("name");
@@ -952,6 +953,7 @@ void Reader::read_structures(const Value& v, fsi::Scene& scene) const {
     if (auto x = m.get("layers")) st.layers = integer(*x, 1, "an integer >= 1");
     st.reference_point = st.position;
     if (auto x = m.get("reference_point")) st.reference_point = point(*x, dims, "m");
+    read_motion(m, dims, st);
     if (auto cv = m.get("coefficients")) {
       MapView c(*this, *cv, {"flow_direction", "lift_direction", "velocity", "density", "length", "area"}, false);
       if (dims == 2 && c.has("area"))
@@ -986,6 +988,86 @@ void Reader::read_structures(const Value& v, fsi::Scene& scene) const {
       if (dims == 3) st.reference_area = number(c.need("area"), positive(), "m^2");
     }
     scene.structures.push_back(st);
+  }
+}
+
+// motion: fixed | free (| prescribed | bullet, refused until they exist) and a free body's mass
+// properties and locks. Keys that only a free body uses are refused on a fixed one, so that a
+// forgotten 'motion: free' does not pass silently.
+void Reader::read_motion(const MapView& m, int dims, fsi::StructureSpec& st) const {
+  const std::vector<std::string> body_keys = {"density", "mass", "centre_of_mass", "inertia", "lock"};
+  if (auto mv = m.get("motion")) {
+    const std::size_t k = choice(*mv, {"fixed", "free", "prescribed", "bullet"});
+    if (k == 2)
+      fail(mv->mark, "'motion: prescribed' is not available yet (issue #8); use fixed or free");
+    if (k == 3)
+      fail(mv->mark, "'motion: bullet' is not available yet: Bullet is not built into this turbid (issue #8); "
+                     "use 'motion: free' for the built-in rigid-body integrator");
+    if (k == 1) st.motion = fsi::StructureSpec::Motion::free;
+  }
+  if (st.motion == fsi::StructureSpec::Motion::fixed) {
+    for (const auto& key : body_keys)
+      if (m.has(key))
+        fail(m.key_mark(key), "'" + key + "' applies to a moving structure; structure '" + st.name +
+                                  "' is fixed (add 'motion: free')");
+    return;
+  }
+  if (m.has("reference_point"))
+    fail(m.key_mark("reference_point"), "a free structure's torques are about its centre of mass, which moves with "
+                                        "it: 'reference_point' does not apply to 'motion: free'");
+  const bool has_density = m.has("density"), has_mass = m.has("mass");
+  if (has_density && has_mass)
+    fail(m.key_mark("mass"), "give either 'density' or 'mass' for free structure '" + st.name + "', not both");
+  if (!has_density && !has_mass)
+    fail(m.key_mark("motion"), "free structure '" + st.name + "' needs 'density' [kg/m^3] (mass, centre and inertia "
+                               "from its shape) or 'mass' [" + std::string(dims == 2 ? "kg/m" : "kg") + "]");
+  if (has_density) st.density = number(m.need("density"), positive(), "kg/m^3");
+  if (has_mass) st.mass = number(m.need("mass"), positive(), dims == 2 ? "kg/m" : "kg");
+  if (auto c = m.get("centre_of_mass")) {
+    st.has_centre_of_mass = true;
+    st.centre_of_mass = point(*c, dims, "m");
+  }
+  if (auto iv = m.get("inertia")) {
+    st.has_inertia = true;
+    if (dims == 2) {
+      // A lamina turns about z only: I_zz per metre of depth.
+      st.inertia[8] = number(*iv, positive(), "kg m^2/m");
+    } else if (iv->node.IsSequence() && iv->node.size() == 3 && !iv->node[0].IsSequence()) {
+      const Vec3d d = point(*iv, 3, "kg m^2");
+      for (int a = 0; a < 3; ++a) {
+        if (!(d[std::size_t(a)] > 0))
+          fail(iv->mark, "the principal moments in 'inertia' must be positive [kg m^2], got " + describe(iv->node));
+        st.inertia[std::size_t(4 * a)] = d[std::size_t(a)];
+      }
+    } else if (iv->node.IsSequence() && iv->node.size() == 3) {
+      for (std::size_t r = 0; r < 3; ++r) {
+        const YAML::Node row = iv->node[r];
+        const Vec3d rv = point({row, row.Mark().is_null() ? iv->mark : row.Mark(), "row " + std::to_string(r + 1) +
+                                                                                       " of 'inertia'"},
+                               3, "kg m^2");
+        for (std::size_t c = 0; c < 3; ++c) st.inertia[3 * r + c] = rv[c];
+      }
+      for (std::size_t r = 0; r < 3; ++r)
+        for (std::size_t c = r + 1; c < 3; ++c)
+          if (std::abs(st.inertia[3 * r + c] - st.inertia[3 * c + r]) >
+              1e-12 * std::max(std::abs(st.inertia[3 * r + c]), std::abs(st.inertia[3 * c + r])))
+            fail(iv->mark, "'inertia' must be a symmetric tensor: row " + std::to_string(r + 1) + " column " +
+                               std::to_string(c + 1) + " differs from row " + std::to_string(c + 1) + " column " +
+                               std::to_string(r + 1));
+    } else {
+      fail(iv->mark, "'inertia' must be the principal moments [Ixx, Iyy, Izz] or a 3 x 3 tensor [[..], [..], [..]] "
+                     "in kg m^2 about the centre of mass, got " + describe(iv->node));
+    }
+  }
+  if (auto lv = m.get("lock")) {
+    const std::vector<std::string> dofs = dims == 2 ? std::vector<std::string>{"x", "y", "rz"}
+                                                    : std::vector<std::string>{"x", "y", "z", "rx", "ry", "rz"};
+    for (const Value& d : list(*lv)) {
+      const std::size_t k = choice(d, dofs, dims == 2 ? "a 2D body moves in x and y and turns about z" : "");
+      const std::string& name = dofs[k];
+      if (name[0] == 'r') st.lock_rotation[std::size_t(name[1] - 'x')] = true;
+      else st.lock_translation[std::size_t(name[0] - 'x')] = true;
+    }
   }
 }
 

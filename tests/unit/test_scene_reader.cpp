@@ -138,6 +138,15 @@ const BadScene kBadScenes[] = {
     {"structures.yaml", 11, 31, "mesh file 'meshes/pipe.stl' not found",
      "a missing mesh file is reported at its name, with where it was looked for"},
     {"structure_two_shapes.yaml", 11, 18, "has both 'box' and 'sphere'", "a structure with two shapes"},
+    {"motion_bullet.yaml", 11, 50, "'motion: bullet' is not available yet: Bullet is not built into this turbid",
+     "Bullet motion is refused at its value until Bullet is linked (issue #8)"},
+    {"motion_typo.yaml", 11, 50, "'motion' must be one of", "an unknown motion names the choices"},
+    {"free_without_mass.yaml", 11, 42, "free structure 'box' needs 'density' [kg/m^3]",
+     "a free body without density or mass is located at its 'motion' key"},
+    {"density_on_fixed.yaml", 11, 42, "'density' applies to a moving structure; structure 'box' is fixed",
+     "a body key on a fixed structure (a forgotten 'motion: free') is not ignored"},
+    {"lock_z_in_2d.yaml", 11, 80, "a 2D body moves in x and y and turns about z",
+     "a 2D body cannot lock z (it is always locked)"},
     {"transition_density.yaml", 13, 24, "material 'turbidity' has density 1100 kg/m^3 but 'debris' has 1950 kg/m^3: "
      "splitting conserves density", "a transition between materials of different reference densities, at 'to'"},
     {"transition_unknown_material.yaml", 13, 24, "unknown material 'turbidty' in item 1 of 'transitions'; did you mean "

@@ -106,12 +106,39 @@ class CpuBackend final : public Backend {
     return loads_impl<3>(reference);
   }
 
+  bool supports_moving_bodies() const override { return true; }
+  void place_bodies(const std::vector<BodyPlacement>& bodies, bool move) override {
+    if (ids_.body_offset < 0) throw std::logic_error("place_bodies: the store has no body_offset field");
+    if (params_.dimensions == 2) place_impl<2>(bodies, move);
+    else place_impl<3>(bodies, move);
+  }
+
   bool supports_splitting() const override { return true; }
   SplitCounts split(const SplitParams& rules) override {
     return params_.dimensions == 2 ? split_impl<2>(rules) : split_impl<3>(rules);
   }
   std::size_t relax_split(const SplitParams& rules) override {
     return params_.dimensions == 2 ? relax_impl<2>(rules) : relax_impl<3>(rules);
+  }
+
+  template <int D>
+  void place_impl(const std::vector<BodyPlacement>& bodies, bool move) {
+    auto& s = *store_;
+    PlaceBodiesPass<D> pass;
+    pass.position = s.data<Vec<D>>(ids_.position);
+    pass.velocity = s.data<Vec<D>>(ids_.velocity);
+    pass.kind = s.data<std::uint8_t>(ids_.kind);
+    pass.body = s.data<std::uint8_t>(ids_.body);
+    pass.offset = s.data<Vec<D>>(ids_.body_offset);
+    if (ids_.body_normal >= 0) {
+      pass.boundary_normal = s.data<Vec<D>>(ids_.boundary_normal);
+      pass.normal0 = s.data<Vec<D>>(ids_.body_normal);
+    }
+    pass.bodies = bodies.data();
+    pass.body_count = int(bodies.size());
+    pass.move = move;
+    parallel_for(std::uint32_t(s.size()), pass);
+    if (move) soa_valid_ = false;  // the sorted coordinate copy no longer matches the positions
   }
 
   template <int D>

@@ -1,0 +1,63 @@
+// Rigid bodies in the fluid's time step; see body_coupling.hpp.
+#include "fsi/body_coupling.hpp"
+
+#include <utility>
+
+namespace turbid::fsi {
+
+BodyCoupling::BodyCoupling(std::vector<std::optional<RigidBody>> bodies, const Eigen::Vector3d& gravity)
+    : bodies_(std::move(bodies)), gravity_(gravity), fluid_(bodies_.size()), placement_(bodies_.size()) {}
+
+Wrench BodyCoupling::total_load(std::size_t k) const {
+  Wrench w = fluid_[k];
+  if (bodies_[k]) w.force += bodies_[k]->mass() * gravity_;
+  return w;
+}
+
+void BodyCoupling::place(sph::Backend& backend, bool move) const {
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    sph::BodyPlacement& p = placement_[k];
+    p.moving = bodies_[k].has_value();
+    if (!p.moving) continue;
+    const RigidBody& b = *bodies_[k];
+    const Eigen::Matrix3d R = b.orientation().toRotationMatrix();
+    const Eigen::Vector3d w = b.angular_velocity();
+    for (int a = 0; a < 3; ++a) {
+      p.centre[a] = b.position()[a];
+      p.velocity[a] = b.velocity()[a];
+      p.angular_velocity[a] = w[a];
+      for (int c = 0; c < 3; ++c) p.rotation[a][c] = R(a, c);
+    }
+  }
+  backend.place_bodies(placement_, move);
+}
+
+void BodyCoupling::after_kick(sph::Backend& backend, double half_dt) {
+  for (std::size_t k = 0; k < bodies_.size(); ++k)
+    if (bodies_[k]) bodies_[k]->kick(half_dt, total_load(k));
+  place(backend, false);
+}
+
+void BodyCoupling::after_drift(sph::Backend& backend, double dt) {
+  for (auto& b : bodies_)
+    if (b) b->drift(dt);
+  place(backend, true);
+}
+
+void BodyCoupling::after_forces(sph::Backend& backend) {
+  std::vector<std::array<double, 3>> reference(bodies_.size(), {0, 0, 0});
+  for (std::size_t k = 0; k < bodies_.size(); ++k)
+    if (bodies_[k])
+      for (int a = 0; a < 3; ++a) reference[k][std::size_t(a)] = bodies_[k]->position()[a];
+  const std::vector<sph::BodyLoad> loads = backend.body_loads(reference);
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    fluid_[k] = Wrench{};
+    if (!bodies_[k]) continue;
+    for (int a = 0; a < 3; ++a) {
+      fluid_[k].force[a] = loads[k].force[std::size_t(a)];
+      fluid_[k].torque[a] = loads[k].torque[std::size_t(a)];
+    }
+  }
+}
+
+}  // namespace turbid::fsi

@@ -1,0 +1,57 @@
+// Couples the built-in rigid bodies (motion: free, rigid_body.hpp) to the fluid's kick-drift-kick
+// step (sph/solver.hpp, StepCoupling):
+//   after the fluid's half-kick:  each body is kicked by half_dt with the load of the last force
+//                                 pass; its particles take the new rigid velocity v + w x r;
+//   after the fluid's drift:      each body drifts by dt; its particles are placed rigidly,
+//                                 x = x_c + R r0, with the rigid velocity (sph/body_motion.hpp);
+//   after the force pass:         load = the fluid's force and torque about the body's current
+//                                 centre of mass (Backend::body_loads, the exact reaction of the
+//                                 fluid's pair terms: Newton's third law) + m g.
+// So the body's particles carry v(n+1/2) while the fluid's density rate and forces are computed,
+// as the fluid's own particles do. Fixed structures are left alone, and a scene without free
+// bodies never builds one of these (no field, no pass). No I/O here.
+#pragma once
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "fsi/rigid_body.hpp"
+#include "sph/backend.hpp"
+#include "sph/solver.hpp"
+
+namespace turbid::fsi {
+
+class BodyCoupling final : public sph::StepCoupling {
+ public:
+  // One entry per structure in scene order: a body for a free structure, none for a fixed one.
+  // gravity [m/s^2].
+  BodyCoupling(std::vector<std::optional<RigidBody>> bodies, const Eigen::Vector3d& gravity);
+
+  void after_kick(sph::Backend& backend, double half_dt) override;
+  void after_drift(sph::Backend& backend, double dt) override;
+  void after_forces(sph::Backend& backend) override;
+
+  // Puts the particles where the bodies are now (move) or only gives them the bodies' velocity.
+  void place(sph::Backend& backend, bool move) const;
+
+  std::size_t structure_count() const { return bodies_.size(); }
+  bool is_free(std::size_t k) const { return bodies_[k].has_value(); }
+  const RigidBody& body(std::size_t k) const { return *bodies_[k]; }
+  RigidBody& body(std::size_t k) { return *bodies_[k]; }
+  // The fluid's force and torque about the centre of mass of body k from the last force pass
+  // (zero for fixed structures), and the whole load its next kick uses (fluid + gravity).
+  const Wrench& fluid_load(std::size_t k) const { return fluid_[k]; }
+  Wrench total_load(std::size_t k) const;
+  // Checkpoints: a resumed run gets back the last force pass's fluid loads, which the first kick
+  // after the resume needs (the per-particle structure forces are not checkpointed).
+  void restore_fluid_load(std::size_t k, const Wrench& w) { fluid_[k] = w; }
+
+ private:
+  std::vector<std::optional<RigidBody>> bodies_;
+  Eigen::Vector3d gravity_;
+  std::vector<Wrench> fluid_;
+  mutable std::vector<sph::BodyPlacement> placement_;
+};
+
+}  // namespace turbid::fsi
