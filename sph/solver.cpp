@@ -106,6 +106,8 @@ void Solver::split() {
     removed_ += backend_->update_neighbours();
     if (split_.relax_iterations > 0 && backend_->relax_split(split_) > 0) removed_ += backend_->update_neighbours();
     backend_->compute_forces();
+    // A body's next half-kick takes the fluid's load on the particles as they are now, as the fluid's does.
+    if (coupling_) coupling_->after_forces(*backend_);
     if (coupling_) coupling_->after_forces(*backend_);
     check("the split after step");
   }
