@@ -103,12 +103,25 @@ struct WallSpec {
   SourceLocation where;
 };
 
-// A structure: a solid sampled into boundary particles (kind structure), fixed or free (the built-in
-// rigid-body integrator, fsi/rigid_body.hpp, coupled to the fluid by fsi/body_coupling.hpp). The
+// DEM contact material of a moving structure (fsi/contact.hpp): Hertz normal force with a damping
+// that gives `restitution`, Coulomb friction `friction` through a tangential spring. A structure
+// without it (given = false) takes part in no contact.
+struct ContactMaterialSpec {
+  bool given = false;
+  double youngs_modulus = 0;  // E [Pa]
+  double poisson_ratio = 0.3; // nu [-]
+  double restitution = 0.5;   // e [-], in (0, 1]
+  double friction = 0.5;      // Coulomb mu [-]
+  SourceLocation where;
+};
+
+// A structure: a solid sampled into boundary particles (kind structure), fixed, free (the built-in
+// rigid-body integrator, fsi/rigid_body.hpp, coupled to the fluid by fsi/body_coupling.hpp),
+// prescribed (moved along a given path) or bullet (moved by the Bullet physics library). The
 // fluid force on it is reported in forces.csv.
 struct StructureSpec {
   enum class Shape { box, sphere, cylinder, mesh };
-  enum class Motion { fixed, free };
+  enum class Motion { fixed, free, prescribed, bullet };
   std::string name;
   Shape shape = Shape::box;
   Vec3d size{0, 0, 0};      // box: extents [m]
@@ -145,6 +158,30 @@ struct StructureSpec {
   std::array<double, 9> inertia{0, 0, 0, 0, 0, 0, 0, 0, 0};
   std::array<bool, 3> lock_translation{false, false, false};  // x, y, z locked
   std::array<bool, 3> lock_rotation{false, false, false};     // rx, ry, rz locked
+  ContactMaterialSpec contact;     // moving structures: DEM contacts with walls and other structures
+  SourceLocation where;
+};
+
+// A constraint on moving structures (motion: free or bullet), from the scene's `constraints:` list.
+// Each end is a point of a structure or a fixed anchor, given in world coordinates at t = 0 (a
+// structure's point then moves rigidly with it).
+struct ConstraintEndSpec {
+  int structure = -1;        // index in Scene::structures; -1 = a fixed anchor
+  Vec3d point{0, 0, 0};      // world position at t = 0 [m]
+};
+struct ConstraintSpec {
+  enum class Type {
+    spring,  // linear spring and dashpot between the two ends (fsi/spring_damper.hpp)
+    hinge,   // the two ends' points stay together; relative rotation only about `axis`
+  };
+  Type type = Type::spring;
+  std::string name;
+  ConstraintEndSpec a;
+  ConstraintEndSpec b;
+  double stiffness = 0;        // spring: k [N/m] (2D: N/m per metre of depth)
+  double damping = 0;          // spring: c [N s/m] (2D: per metre of depth)
+  double rest_length = -1;     // spring: L0 [m]; < 0 = the ends' distance at t = 0
+  Vec3d axis{0, 0, 1};         // hinge: unit axis, world frame at t = 0
   SourceLocation where;
 };
 
@@ -228,6 +265,7 @@ struct Scene {
   std::vector<FluidBlock> fluids;
   std::vector<WallSpec> walls;
   std::vector<StructureSpec> structures;
+  std::vector<ConstraintSpec> constraints;
   std::vector<OpenBoundarySpec> open_boundaries;
   std::vector<ProbeSpec> probes;
   std::vector<TransitionSpec> transitions;
