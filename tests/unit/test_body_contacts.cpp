@@ -1,0 +1,279 @@
+// Constraints and DEM contacts of free bodies in coupled runs (fsi/body_contacts.hpp,
+// fsi/body_constraints.hpp, fsi/body_coupling.hpp; issue #8), through the scene reader and the
+// Simulation, with a tiny block of water in its own closed tank far away (a Simulation needs fluid).
+// References and tolerances, per test:
+//  - a 2D block hanging on a spring under gravity oscillates at omega = sqrt(k/m) (the weight only
+//    shifts the equilibrium): the period between turning points within 0.5% of 2 pi sqrt(m/k);
+//  - a spring between two bodies (no gravity) is central: total momentum stays 0 to double rounding
+//    (1e-12 of m |v|) and the total angular momentum about the origin too;
+//  - a disc dropped on the tank floor rebounds with the scene's restitution: -v_out / v_in within 5%
+//    of e = 0.5 (v at the last step before the touch and the first after it);
+//  - a box on a 30 degree polyline slope with mu = 0.3 slides with a = g (sin - mu cos) within 2%
+//    (least-squares slope of the velocity along the incline over t = 0.05 .. 0.3 s); on a 20 degree
+//    slope with mu = 0.5 (tan 20 = 0.36 < mu) it moves less than 1% of dx in 0.3 s (the tangential
+//    springs' elastic deflection is ~1e-5 m here; sliding would take it 0.1 m);
+//  - hard case: two boxes thrown by a tilted gravity into each other and a corner of the tank never
+//    interpenetrate by more than 0.1 dx, measured on the particles (dx minus the smallest distance
+//    between surface particles of the two bodies; dx/2 minus a surface particle's distance to a wall).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "fsi/simulation.hpp"
+#include "tools/scene_reader.hpp"
+
+namespace {
+
+using namespace turbid;
+
+fsi::RunOptions cpu() {
+  fsi::RunOptions r;
+  r.backend = "cpu";
+  r.threads = 1;
+  return r;
+}
+
+fsi::Scene scene_of(const std::string& yaml) { return tools::read_scene_string(yaml, "test.yaml"); }
+
+// Scene head: 2D, dx = 0.01 m, a closed 0.1 x 0.05 m tank full of water at x = 3 m.
+std::string head(const std::string& name, const std::string& gravity, double end) {
+  return "name: " + name + R"(
+dimensions: 2
+resolution: {particle_spacing: 0.01, smoothing_ratio: 1.3}
+time: {end: )" + std::to_string(end) + R"(, cfl: 0.2}
+gravity: )" + gravity + R"(
+materials:
+  water: {density: 1000, sound_speed: 10}
+fluids:
+  - {material: water, box: {min: [3.0, 0], max: [3.1, 0.05]}}
+domain: {min: [-0.5, -0.5], max: [3.5, 2.0]}
+)";
+}
+const char* kFarTank = "  - box: {min: [3.0, 0], max: [3.1, 0.05]}\n";
+
+// Linear interpolation of the time where v crosses zero between two samples.
+double crossing(double t0, double v0, double t1, double v1) { return t0 + (t1 - t0) * v0 / (v0 - v1); }
+
+TEST(BodyConstraints, SpringMassOscillatesAtSqrtKOverM) {
+  const double k = 500, m = 500 * 0.1 * 0.1;  // N/m per m, kg/m (the sampled box's mass is exact)
+  const std::string yaml = head("spring", "[0, -9.81]", 2.0) + "walls:\n" + kFarTank + R"(structures:
+  - {name: block, box: {size: [0.1, 0.1]}, position: [0.5, 1.0], motion: free, density: 500}
+constraints:
+  - {type: spring, name: hang, a: {structure: block, point: [0.5, 1.0]}, b: {anchor: [0.5, 1.3]}, stiffness: 500}
+)";
+  fsi::Simulation sim(scene_of(yaml), cpu());
+  sim.start();
+  ASSERT_NE(sim.bodies(), nullptr);
+  const fsi::RigidBody& b = sim.bodies()->body(0);
+  ASSERT_NEAR(b.mass(), m, 1e-12 * m);
+  std::vector<double> turns;  // times where v_y goes from - to + (lowest points)
+  double t_prev = sim.time(), v_prev = b.velocity().y();
+  while (sim.time() < 2.0) {
+    sim.step();
+    const double v = b.velocity().y();
+    if (v_prev < 0 && v >= 0) turns.push_back(crossing(t_prev, v_prev, sim.time(), v));
+    t_prev = sim.time();
+    v_prev = v;
+  }
+  ASSERT_GE(turns.size(), 2u);
+  const double period = (turns.back() - turns.front()) / double(turns.size() - 1);
+  const double expected = 2 * std::numbers::pi * std::sqrt(m / k);
+  std::printf("[ measured ] spring-mass period %.6f s against 2 pi sqrt(m/k) = %.6f s (%+.4f%%), %zu periods, "
+              "%d body substeps per fluid step (dt %.3e s)\n",
+              period, expected, 100 * (period / expected - 1), turns.size() - 1, sim.bodies()->last_substeps(),
+              sim.last_time_step());
+  EXPECT_NEAR(period, expected, 0.005 * expected);
+  // The weight moves the centre of the swing down to m g / k below the spring's rest position.
+  // A spring at the centre of mass exerts no torque: the sampled centre and the attachment point
+  // differ by double rounding only (~1e-16 m of lever under ~50 N), so the block turns by far less
+  // than 1e-9 rad.
+  const double angle = 2 * std::asin(std::min(1.0, b.orientation().vec().norm()));
+  EXPECT_LT(angle, 1e-9);
+}
+
+TEST(BodyConstraints, SpringBetweenTwoBodiesConservesMomentum) {
+  const std::string yaml = head("pair", "[0, 0]", 0.2) + "walls:\n" + kFarTank + R"(structures:
+  - {name: left, box: {size: [0.1, 0.1]}, position: [0.5, 1.0], rotation: 10, motion: free, density: 500}
+  - {name: right, box: {size: [0.2, 0.1]}, position: [0.9, 1.05], motion: free, density: 800}
+constraints:
+  - {type: spring, a: {structure: left, point: [0.53, 1.02]}, b: {structure: right, point: [0.82, 1.0]},
+     stiffness: 800, damping: 2, rest_length: 0.2}
+)";
+  fsi::Simulation sim(scene_of(yaml), cpu());
+  sim.start();
+  const fsi::RigidBody& a = sim.bodies()->body(0);
+  const fsi::RigidBody& c = sim.bodies()->body(1);
+  double scale = 0, worst_p = 0, worst_l = 0;
+  for (int n = 0; n < 400; ++n) {
+    sim.step();
+    const Eigen::Vector3d p = a.linear_momentum() + c.linear_momentum();
+    const Eigen::Vector3d l = a.position().cross(a.linear_momentum()) + a.angular_momentum() +
+                              c.position().cross(c.linear_momentum()) + c.angular_momentum();
+    scale = std::max(scale, a.linear_momentum().norm() + c.linear_momentum().norm());
+    worst_p = std::max(worst_p, p.norm());
+    worst_l = std::max(worst_l, l.norm());
+  }
+  std::printf("[ measured ] two bodies on a spring: |P| <= %.3e, |L| <= %.3e (momentum scale %.3e kg m/s)\n", worst_p,
+              worst_l, scale);
+  ASSERT_GT(scale, 1e-3) << "the stretched spring should set the bodies moving";
+  EXPECT_LE(worst_p, 1e-12 * scale);
+  EXPECT_LE(worst_l, 1e-12 * scale);
+}
+
+TEST(BodyContacts, DiscDroppedOnTheFloorReboundsWithTheRestitution) {
+  const double e = 0.5;
+  const std::string yaml = head("drop", "[0, -9.81]", 0.3) + "walls:\n  - box: {min: [0, 0], max: [0.6, 0.6]}\n" +
+                           kFarTank + R"(structures:
+  - {name: ball, sphere: {radius: 0.05}, position: [0.3, 0.25], motion: free, density: 1000,
+     contact: {youngs_modulus: 1.0e8, poisson_ratio: 0.3, restitution: 0.5, friction: 0.3}}
+)";
+  fsi::Simulation sim(scene_of(yaml), cpu());
+  sim.start();
+  const fsi::RigidBody& b = sim.bodies()->body(0);
+  double v_in = 0, v_out = 0;
+  bool touched = false;
+  int substeps = 0;
+  while (sim.time() < 0.3) {
+    const double v_before = b.velocity().y();
+    sim.step();
+    const bool touching = sim.bodies()->contact_load(0).force.norm() > 0;
+    if (touching && !touched) {
+      touched = true;
+      v_in = v_before;
+    }
+    substeps = std::max(substeps, sim.bodies()->last_substeps());
+    if (touched && !touching) {
+      v_out = b.velocity().y();
+      break;
+    }
+  }
+  ASSERT_TRUE(touched);
+  ASSERT_GT(v_out, 0) << "the ball should have left the floor by t = 0.3 s";
+  const double measured = -v_out / v_in;
+  std::printf("[ measured ] disc on the floor: v_in = %.4f m/s, v_out = %.4f m/s, e = %.4f against %.2f (%+.2f%%), "
+              "up to %d body substeps per fluid step\n",
+              v_in, v_out, measured, e, 100 * (measured / e - 1), substeps);
+  EXPECT_NEAR(measured, e, 0.05 * e);
+}
+
+// A 0.1 x 0.05 m box resting on a polyline slope of `degrees`, friction mu; returns the box's
+// velocity and displacement along the slope (down the slope negative) sampled every step.
+struct SlopeRun {
+  std::vector<double> t, v, s;
+};
+SlopeRun slide(double degrees, double mu, double end) {
+  const double th = degrees * std::numbers::pi / 180, c = std::cos(th), s = std::sin(th);
+  const double along = 0.7, half = 0.025;
+  const double cx = along * c - half * s, cy = along * s + half * c;
+  char buf[1024];
+  std::snprintf(buf, sizeof buf, R"(walls:
+  - polyline: {points: [[0, 0], [%.17g, %.17g]]}
+%sstructures:
+  - {name: block, box: {size: [0.1, 0.05]}, position: [%.17g, %.17g], rotation: %.17g, motion: free, density: 1000,
+     contact: {youngs_modulus: 1.0e8, poisson_ratio: 0.3, restitution: 0.5, friction: %.17g}}
+)",
+                c, s, kFarTank, cx, cy, degrees, mu);
+  fsi::Simulation sim(scene_of(head("slope", "[0, -9.81]", end) + buf), cpu());
+  sim.start();
+  const fsi::RigidBody& b = sim.bodies()->body(0);
+  const Eigen::Vector3d x0 = b.position(), u(c, s, 0);
+  SlopeRun r;
+  while (sim.time() < end) {
+    sim.step();
+    r.t.push_back(sim.time());
+    r.v.push_back(b.velocity().dot(u));
+    r.s.push_back((b.position() - x0).dot(u));
+  }
+  return r;
+}
+
+TEST(BodyContacts, BoxSlidesDownAnInclineWithCoulombFriction) {
+  const double degrees = 30, mu = 0.3, g = 9.81;
+  const double th = degrees * std::numbers::pi / 180;
+  const double expected = -g * (std::sin(th) - mu * std::cos(th));
+  const SlopeRun r = slide(degrees, mu, 0.3);
+  // Least-squares line v = v0 + a t over t >= 0.05 s (after the first settling).
+  double n = 0, st = 0, sv = 0, stt = 0, stv = 0;
+  for (std::size_t i = 0; i < r.t.size(); ++i) {
+    if (r.t[i] < 0.05) continue;
+    n += 1;
+    st += r.t[i];
+    sv += r.v[i];
+    stt += r.t[i] * r.t[i];
+    stv += r.t[i] * r.v[i];
+  }
+  const double a = (n * stv - st * sv) / (n * stt - st * st);
+  std::printf("[ measured ] box on a %.0f degree slope, mu = %.2f: a = %.4f m/s^2 against g (sin - mu cos) = %.4f "
+              "(%+.3f%%), slid %.4f m\n",
+              degrees, mu, a, expected, 100 * (a / expected - 1), r.s.back());
+  EXPECT_NEAR(a, expected, 0.02 * std::abs(expected));
+}
+
+TEST(BodyContacts, BoxStaysPutWhenTheSlopeIsBelowTheFrictionAngle) {
+  const double dx = 0.01;
+  const SlopeRun r = slide(20, 0.5, 0.3);
+  double worst = 0;
+  for (double s : r.s) worst = std::max(worst, std::abs(s));
+  std::printf("[ measured ] box on a 20 degree slope, mu = 0.5: largest displacement along the slope %.3e m "
+              "(%.2e dx), final speed %.3e m/s\n",
+              worst, worst / dx, r.v.back());
+  EXPECT_LT(worst, 0.01 * dx);
+}
+
+TEST(BodyContacts, BodiesDrivenIntoEachOtherAndACornerDoNotInterpenetrate) {
+  const double dx = 0.01;
+  // Gravity tilted towards -x: the lower box is pressed into the corner, the upper one falls on it
+  // and both are pushed against the left wall.
+  const std::string yaml = head("pile", "[-6.0, -9.81]", 0.5) + "walls:\n  - box: {min: [0, 0], max: [0.6, 0.6]}\n" +
+                           kFarTank + R"(structures:
+  - {name: lower, box: {size: [0.12, 0.08]}, position: [0.12, 0.06], rotation: 5, motion: free, density: 1200,
+     contact: {youngs_modulus: 3.0e10, poisson_ratio: 0.3, restitution: 0.3, friction: 0.4}}
+  - {name: upper, box: {size: [0.1, 0.1]}, position: [0.2, 0.3], rotation: -20, motion: free, density: 2000,
+     contact: {youngs_modulus: 3.0e10, poisson_ratio: 0.3, restitution: 0.3, friction: 0.4}}
+)";
+  fsi::Simulation sim(scene_of(yaml), cpu());
+  sim.start();
+  const auto& st = sim.store();
+  const auto& ids = sim.fields();
+  double worst_pair = -1e9, worst_wall = -1e9, worst_sphere = 0;
+  int touched_pair = 0;
+  while (sim.time() < 0.5) {
+    sim.step();
+    worst_sphere = std::max(worst_sphere, sim.bodies()->last_max_overlap());
+    const auto* x = st.data<float>(ids.position);
+    const auto* kind = st.data<std::uint8_t>(ids.kind);
+    const auto* body = st.data<std::uint8_t>(ids.body);
+    std::vector<std::size_t> p0, p1;
+    for (std::size_t i = 0; i < st.size(); ++i) {
+      if (kind[i] != 2) continue;
+      (body[i] == 0 ? p0 : p1).push_back(i);
+      // Surface particles lie dx/2 inside the surface: to the walls x = 0, y = 0 (and x, y = 0.6).
+      const double d = std::min({double(x[2 * i]), double(x[2 * i + 1]), 0.6 - x[2 * i], 0.6 - x[2 * i + 1]});
+      worst_wall = std::max(worst_wall, 0.5 * dx - d);
+    }
+    double closest = 1e9;
+    for (std::size_t i : p0)
+      for (std::size_t j : p1)
+        closest = std::min(closest, std::hypot(double(x[2 * i] - x[2 * j]), double(x[2 * i + 1] - x[2 * j + 1])));
+    worst_pair = std::max(worst_pair, dx - closest);
+    if (closest < dx) ++touched_pair;
+  }
+  const auto& lo = sim.bodies()->body(0);
+  const auto& up = sim.bodies()->body(1);
+  std::printf("[ measured ] pile in the corner: body-body overlap <= %.3e m (%.4f dx), body-wall <= %.3e m (%.4f dx), "
+              "contact spheres <= %.3e m; steps with the bodies touching %d; final x %.4f, %.4f m\n",
+              worst_pair, worst_pair / dx, worst_wall, worst_wall / dx, worst_sphere, touched_pair, lo.position().x(),
+              up.position().x());
+  EXPECT_GT(touched_pair, 100) << "the upper box should land on the lower one";
+  EXPECT_LT(lo.position().x(), 0.1) << "gravity should press the lower box into the corner";
+  EXPECT_LE(worst_pair, 0.1 * dx);
+  EXPECT_LE(worst_wall, 0.1 * dx);
+  EXPECT_LE(worst_sphere, 0.1 * dx);
+}
+
+}  // namespace
