@@ -80,17 +80,9 @@ BodyContacts::BodyContacts(std::vector<BodyContactShape> shapes, const std::vect
 
 void BodyContacts::add(const ContactLaw& law, const ContactGeometry& g, const ContactKey& key, const RigidBody& body,
                        const Eigen::Vector3d& velocity_2, const RigidBody* body_2, std::size_t k, std::size_t l,
-                       double dt, std::vector<Wrench>& out, std::map<ContactKey, TangentialSpring>& next) {
+                       double, std::vector<Wrench>&, std::map<ContactKey, TangentialSpring>&) {
   if (!(g.overlap > 0)) return;
-  last_max_overlap_ = std::max(last_max_overlap_, g.overlap);
-  TangentialSpring spring;
-  if (const auto it = springs_.find(key); it != springs_.end()) spring = it->second;
-  const Eigen::Vector3d v1 = body.velocity() + body.angular_velocity().cross(g.point - body.position());
-  const ContactForce f = contact_force(law, g.overlap, g.normal, v1 - velocity_2, spring, dt);
-  next.emplace(key, spring);
-  const PairWrench w = contact_wrench(f.force, g.point, &body, body_2);
-  out[k] += w.on_a;
-  if (body_2) out[l] += w.on_b;
+  pending_.push_back({&law, g, key, &body, body_2, velocity_2, k, l});
 }
 
 void BodyContacts::evaluate(const std::vector<std::optional<RigidBody>>& bodies, double dt, std::vector<Wrench>& out) {
@@ -205,19 +197,44 @@ void BodyContacts::evaluate(const std::vector<std::optional<RigidBody>>& bodies,
       const double reach = bounding_[k] + bounding_[l];
       if ((b.position() - o.position()).squaredNorm() >= reach * reach) continue;
       const double r2 = shapes_[l].radius;
-      const Eigen::Vector3d w2 = o.angular_velocity();
       for (std::size_t i = 0; i < centres[k].size(); ++i) {
         const Eigen::Vector3d& c = centres[k][i];
         if ((c - o.position()).norm() >= bounding_[l] + r) continue;
         for (std::size_t m = 0; m < centres[l].size(); ++m) {
           if ((c - centres[l][m]).squaredNorm() >= (r + r2) * (r + r2)) continue;
           const ContactGeometry g = sphere_sphere(c, r, centres[l][m], r2);
-          const Eigen::Vector3d v2 = o.velocity() + w2.cross(g.point - o.position());
-          add(body_law_[k][l].law, g, {int(k), int(i), 3, int(l), int(m)}, b, v2, &o, k, l, dt, out, next);
+          add(body_law_[k][l].law, g, {int(k), int(i), 3, int(l), int(m)}, b, zero, &o, k, l, dt, out, next);
         }
       }
     }
   }
+  // Several contacts of one body with one obstacle (a clump's face on a wall, a disc between two
+  // particles of a fixed structure) act in parallel: each takes the share of the body's mass that its
+  // stiffness k_n sqrt(delta) has of the group's, so the group's damping is that of one contact of the
+  // summed stiffness and the restitution stays the law's (contact.hpp). One contact: the whole mass.
+  std::map<std::array<int, 3>, double> group_stiffness;
+  const auto stiffness_of = [](const Pending& c) {
+    return c.law->effective_modulus * std::sqrt(c.law->effective_radius) * std::sqrt(c.geometry.overlap);
+  };
+  const auto group_of = [](const Pending& c) { return std::array<int, 3>{c.key[0], c.key[2], c.key[3]}; };
+  for (const Pending& c : pending_) group_stiffness[group_of(c)] += stiffness_of(c);
+  for (const Pending& c : pending_) {
+    last_max_overlap_ = std::max(last_max_overlap_, c.geometry.overlap);
+    ContactLaw law = *c.law;
+    law.effective_mass *= stiffness_of(c) / group_stiffness[group_of(c)];
+    TangentialSpring spring;
+    if (const auto it = springs_.find(c.key); it != springs_.end()) spring = it->second;
+    const RigidBody& body = *c.body;
+    const Eigen::Vector3d v1 = body.velocity() + body.angular_velocity().cross(c.geometry.point - body.position());
+    Eigen::Vector3d v2 = c.velocity_2;
+    if (c.body_2) v2 = c.body_2->velocity() + c.body_2->angular_velocity().cross(c.geometry.point - c.body_2->position());
+    const ContactForce f = contact_force(law, c.geometry.overlap, c.geometry.normal, v1 - v2, spring, dt);
+    next.emplace(c.key, spring);
+    const PairWrench w = contact_wrench(f.force, c.geometry.point, &body, c.body_2);
+    out[c.k] += w.on_a;
+    if (c.body_2) out[c.l] += w.on_b;
+  }
+  pending_.clear();
   springs_ = std::move(next);
 }
 

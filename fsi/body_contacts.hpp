@@ -17,6 +17,9 @@
 // whose foot lies inside the face, and only when it has none, the single deepest edge or vertex
 // contact of that wall, so a sphere above the joint of two collinear segments is not pushed twice.
 //
+// Contacts of one body with one obstacle act in parallel; each takes the share of the body's mass
+// that its stiffness has of theirs, so together they damp as one contact and keep the restitution.
+//
 // Pair parameters: E* and G* from both sides' Young's modulus and Poisson ratio (walls and fixed
 // structures without a material are rigid, E = infinity); restitution and friction of a pair are the
 // smaller of the two sides' (a wall without material takes the body's). m* and R* per contact from
@@ -121,6 +124,16 @@ class BodyContacts {
            const Eigen::Vector3d& velocity_2, const RigidBody* body_2, std::size_t k, std::size_t l, double dt,
            std::vector<Wrench>& out, std::map<ContactKey, TangentialSpring>& next);
 
+  struct Pending {  // a contact found, before its force (see evaluate)
+    const ContactLaw* law = nullptr;
+    ContactGeometry geometry;
+    ContactKey key{};
+    const RigidBody* body = nullptr;
+    const RigidBody* body_2 = nullptr;  // nullptr: a wall or fixed structure
+    Eigen::Vector3d velocity_2 = Eigen::Vector3d::Zero();
+    std::size_t k = 0, l = 0;
+  };
+  std::vector<Pending> pending_;
   std::vector<BodyContactShape> shapes_;
   std::vector<double> masses_;
   std::vector<double> bounding_;      // bounding radius of each shape about the centre of mass

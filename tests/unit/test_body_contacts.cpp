@@ -12,11 +12,16 @@
 //    (least-squares slope of the velocity along the incline over t = 0.05 .. 0.3 s); on a 20 degree
 //    slope with mu = 0.5 (tan 20 = 0.36 < mu) it moves less than 1% of dx in 0.3 s (the tangential
 //    springs' elastic deflection is ~1e-5 m here; sliding would take it 0.1 m);
+//  - a 2D box on a hinge (a stiff pivot, body_constraints.hpp) swings as a compound pendulum,
+//    T = 2 pi sqrt(I_pivot / (m g d)) (1 + theta0^2/16) within 0.5%, its pivot opening below 1% of dx;
+//  - the disc dropped on a solid_box wall (exact face) and on a fixed box structure (its surface
+//    particles as dx/2 spheres) rebounds with e within 5% as well; a 3D sphere on a tank floor too;
 //  - hard case: two boxes thrown by a tilted gravity into each other and a corner of the tank never
 //    interpenetrate by more than 0.1 dx, measured on the particles (dx minus the smallest distance
 //    between surface particles of the two bodies; dx/2 minus a surface particle's distance to a wall).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -24,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "fsi/forces.hpp"
 #include "fsi/simulation.hpp"
 #include "tools/scene_reader.hpp"
 
@@ -159,6 +165,127 @@ TEST(BodyContacts, DiscDroppedOnTheFloorReboundsWithTheRestitution) {
               "up to %d body substeps per fluid step\n",
               v_in, v_out, measured, e, 100 * (measured / e - 1), substeps);
   EXPECT_NEAR(measured, e, 0.05 * e);
+}
+
+// The first bounce of body 0: -v_out / v_in along `axis` (v at the last step before the touch and the
+// first step after it), or 0 when it did not bounce by `end`.
+double bounce(fsi::Simulation& sim, int axis, double end, double* v_in_out = nullptr) {
+  const fsi::RigidBody& b = sim.bodies()->body(0);
+  double v_in = 0;
+  bool touched = false;
+  while (sim.time() < end) {
+    const double v_before = b.velocity()[axis];
+    sim.step();
+    const bool touching = sim.bodies()->contact_load(0).force.norm() > 0;
+    if (touching && !touched) {
+      touched = true;
+      v_in = v_before;
+    }
+    if (touched && !touching) {
+      if (v_in_out) *v_in_out = v_in;
+      return -b.velocity()[axis] / v_in;
+    }
+  }
+  return 0;
+}
+
+TEST(BodyContacts, DiscReboundsFromASolidBoxAndFromAFixedStructure) {
+  const double e = 0.5;
+  const std::string disc = R"(  - {name: ball, sphere: {radius: 0.05}, position: [0.3, 0.45], motion: free, density: 1000,
+     contact: {youngs_modulus: 1.0e8, poisson_ratio: 0.3, restitution: 0.5, friction: 0.3}}
+)";
+  // On a solid box (an exact face) ...
+  fsi::Simulation on_box(scene_of(head("drop_box", "[0, -9.81]", 0.4) + "walls:\n  - solid_box: {min: [0.1, 0.1], max: [0.5, 0.2]}\n" +
+                                  kFarTank + "structures:\n" + disc),
+                         cpu());
+  on_box.start();
+  double v_box = 0;
+  const double e_box = bounce(on_box, 1, 0.4, &v_box);
+  // ... and on a fixed box structure (its surface particles, spheres of dx/2), whose contact
+  // material is rigid-like and more elastic: the pair takes the smaller restitution, the disc's.
+  fsi::Simulation on_structure(
+      scene_of(head("drop_post", "[0, -9.81]", 0.4) + "walls:\n" + kFarTank + "structures:\n" + disc +
+               "  - {name: post, box: {size: [0.4, 0.1]}, position: [0.3, 0.15], contact: {youngs_modulus: 1.0e10, "
+               "restitution: 0.9, friction: 0.5}}\n"),
+      cpu());
+  on_structure.start();
+  double v_post = 0;
+  const double e_post = bounce(on_structure, 1, 0.4, &v_post);
+  std::printf("[ measured ] disc on a solid box: e = %.4f (v_in %.3f m/s); on a fixed structure: e = %.4f (v_in %.3f m/s); "
+              "against %.2f\n",
+              e_box, v_box, e_post, v_post, e);
+  EXPECT_NEAR(e_box, e, 0.05 * e);
+  EXPECT_NEAR(e_post, e, 0.05 * e);
+  // forces.csv names the contact force with its unit.
+  const auto cols = fsi::force_columns(on_structure.scene());
+  EXPECT_NE(std::find(cols.begin(), cols.end(), "ball.contact_Fy [N/m]"), cols.end());
+  EXPECT_EQ(std::find(cols.begin(), cols.end(), "post.contact_Fy [N/m]"), cols.end()) << "a fixed structure has no body";
+}
+
+TEST(BodyContacts, SphereReboundsFromATankFloorIn3D) {
+  const double e = 0.6;
+  const std::string yaml = R"(name: drop3d
+dimensions: 3
+resolution: {particle_spacing: 0.02, smoothing_ratio: 1.3}
+time: {end: 0.4, cfl: 0.2}
+gravity: [0, 0, -9.81]
+materials:
+  water: {density: 1000, sound_speed: 10}
+walls:
+  - box: {min: [0, 0, 0], max: [0.4, 0.4, 0.5]}
+  - box: {min: [2.0, 0, 0], max: [2.06, 0.06, 0.04]}
+fluids:
+  - {material: water, box: {min: [2.0, 0, 0], max: [2.06, 0.06, 0.04]}}
+structures:
+  - {name: ball, sphere: {radius: 0.06}, position: [0.2, 0.2, 0.3], motion: free, density: 2000,
+     contact: {youngs_modulus: 1.0e9, poisson_ratio: 0.3, restitution: 0.6, friction: 0.3}}
+domain: {min: [-0.2, -0.2, -0.2], max: [2.3, 0.6, 0.7]}
+)";
+  fsi::Simulation sim(scene_of(yaml), cpu());
+  sim.start();
+  double v_in = 0;
+  const double measured = bounce(sim, 2, 0.4, &v_in);
+  const fsi::RigidBody& b = sim.bodies()->body(0);
+  std::printf("[ measured ] 3D sphere on the floor: v_in %.4f m/s, e = %.4f against %.2f (%+.2f%%); x, y drift %.2e, %.2e m\n",
+              v_in, measured, e, 100 * (measured / e - 1), b.position().x() - 0.2, b.position().y() - 0.2);
+  EXPECT_NEAR(measured, e, 0.05 * e);
+}
+
+TEST(BodyConstraints, HingedBoxSwingsAsACompoundPendulum) {
+  const double dx = 0.01, g = 9.81, d = 0.2, theta0 = 5 * std::numbers::pi / 180;
+  // The box's centre hangs d below the hinge, released at theta0 from the vertical.
+  const double hx = 0.5, hy = 1.2, cx = hx + d * std::sin(theta0), cy = hy - d * std::cos(theta0);
+  char buf[1024];
+  std::snprintf(buf, sizeof buf, R"(walls:
+%sstructures:
+  - {name: flap, box: {size: [0.1, 0.1]}, position: [%.17g, %.17g], rotation: %.17g, motion: free, density: 500}
+constraints:
+  - {type: hinge, a: {structure: flap, point: [%.17g, %.17g]}, b: {anchor: [%.17g, %.17g]}}
+)",
+                kFarTank, cx, cy, 5.0, hx, hy, hx, hy);
+  fsi::Simulation sim(scene_of(head("pendulum", "[0, -9.81]", 2.0) + buf), cpu());
+  sim.start();
+  const fsi::RigidBody& b = sim.bodies()->body(0);
+  const Eigen::Vector3d pivot_body = Eigen::Vector3d(hx, hy, 0) - b.position();
+  std::vector<double> turns;
+  double t_prev = sim.time(), w_prev = b.angular_velocity().z(), worst = 0;
+  while (sim.time() < 2.0) {
+    sim.step();
+    const double w = b.angular_velocity().z();
+    if (w_prev > 0 && w <= 0) turns.push_back(crossing(t_prev, w_prev, sim.time(), w));
+    t_prev = sim.time();
+    w_prev = w;
+    worst = std::max(worst, (b.to_world(pivot_body) - Eigen::Vector3d(hx, hy, 0)).norm());
+  }
+  ASSERT_GE(turns.size(), 2u);
+  const double period = (turns.back() - turns.front()) / double(turns.size() - 1);
+  const double m = 500 * 0.01, inertia = m * (0.01 + 0.01) / 12 + m * d * d;
+  const double expected = 2 * std::numbers::pi * std::sqrt(inertia / (m * g * d)) * (1 + theta0 * theta0 / 16);
+  std::printf("[ measured ] hinged box: period %.5f s against %.5f s (%+.3f%%), pivot opening <= %.3e m (%.2e dx), "
+              "%d body substeps per fluid step\n",
+              period, expected, 100 * (period / expected - 1), worst, worst / dx, sim.bodies()->last_substeps());
+  EXPECT_NEAR(period, expected, 0.005 * expected);
+  EXPECT_LT(worst, 0.01 * dx);
 }
 
 // A 0.1 x 0.05 m box resting on a polyline slope of `degrees`, friction mu; returns the box's
