@@ -386,10 +386,12 @@ TEST(BodyContacts, BodiesDrivenIntoEachOtherAndACornerDoNotInterpenetrate) {
   const auto& st = sim.store();
   const auto& ids = sim.fields();
   double worst_pair = -1e9, worst_wall = -1e9, worst_sphere = 0;
+  int most_substeps = 0;
   int touched_pair = 0;
   while (sim.time() < 0.5) {
     sim.step();
     worst_sphere = std::max(worst_sphere, sim.bodies()->last_max_overlap());
+    most_substeps = std::max(most_substeps, sim.bodies()->last_substeps());
     const auto* x = st.data<float>(ids.position);
     const auto* kind = st.data<std::uint8_t>(ids.kind);
     const auto* body = st.data<std::uint8_t>(ids.body);
@@ -411,9 +413,10 @@ TEST(BodyContacts, BodiesDrivenIntoEachOtherAndACornerDoNotInterpenetrate) {
   const auto& lo = sim.bodies()->body(0);
   const auto& up = sim.bodies()->body(1);
   std::printf("[ measured ] pile in the corner: body-body overlap <= %.3e m (%.4f dx), body-wall <= %.3e m (%.4f dx), "
-              "contact spheres <= %.3e m; steps with the bodies touching %d; final x %.4f, %.4f m\n",
+              "contact spheres <= %.3e m; steps with the bodies touching %d; final x %.4f, %.4f m; up to %d body substeps "
+              "per fluid step of %.3e s\n",
               worst_pair, worst_pair / dx, worst_wall, worst_wall / dx, worst_sphere, touched_pair, lo.position().x(),
-              up.position().x());
+              up.position().x(), most_substeps, sim.last_time_step());
   EXPECT_GT(touched_pair, 100) << "the upper box should land on the lower one";
   EXPECT_LT(lo.position().x(), 0.1) << "gravity should press the lower box into the corner";
   EXPECT_LE(worst_pair, 0.1 * dx);
