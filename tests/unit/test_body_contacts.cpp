@@ -19,6 +19,7 @@
 //  - hard case: two boxes thrown by a tilted gravity into each other and a corner of the tank never
 //    interpenetrate by more than 0.1 dx, measured on the particles (dx minus the smallest distance
 //    between surface particles of the two bodies; dx/2 minus a surface particle's distance to a wall).
+//    The same when a 2D dam break drives two boxes into each other and the right wall.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -422,6 +423,71 @@ TEST(BodyContacts, BodiesDrivenIntoEachOtherAndACornerDoNotInterpenetrate) {
   EXPECT_LE(worst_pair, 0.1 * dx);
   EXPECT_LE(worst_wall, 0.1 * dx);
   EXPECT_LE(worst_sphere, 0.1 * dx);
+}
+
+
+// The same bound when the flow drives them: a 2D dam break (0.25 x 0.3 m of water, dx = 0.01 m)
+// strikes two boxes standing on the floor near the right wall and pushes them into each other and
+// into the wall; overlaps measured on the particles as above, bound 0.1 dx.
+TEST(BodyContacts, DamBreakDrivesTwoBoxesIntoEachOtherAndTheWallWithoutInterpenetration) {
+  const double dx = 0.01, end = 0.8;
+  const std::string yaml = R"(name: dam_boxes
+dimensions: 2
+resolution: {particle_spacing: 0.01, smoothing_ratio: 1.3}
+time: {end: 0.8, cfl: 0.2}
+gravity: [0, -9.81]
+materials:
+  water: {density: 1000, sound_speed: 25}
+walls:
+  - box: {min: [0, 0], max: [0.8, 0.5]}
+fluids:
+  - {material: water, box: {min: [0, 0], max: [0.25, 0.3]}}
+structures:
+  - {name: first, box: {size: [0.06, 0.06]}, position: [0.6, 0.03], motion: free, density: 1300,
+     contact: {youngs_modulus: 3.0e10, poisson_ratio: 0.3, restitution: 0.3, friction: 0.3}}
+  - {name: second, box: {size: [0.06, 0.08]}, position: [0.7, 0.04], motion: free, density: 1300,
+     contact: {youngs_modulus: 3.0e10, poisson_ratio: 0.3, restitution: 0.3, friction: 0.3}}
+)";
+  fsi::Simulation sim(scene_of(yaml), cpu());
+  sim.start();
+  const auto& st = sim.store();
+  const auto& ids = sim.fields();
+  double worst_pair = -1e9, worst_wall = -1e9;
+  int touched_pair = 0, touched_wall = 0, most_substeps = 0;
+  const fsi::RigidBody& a = sim.bodies()->body(0);
+  const fsi::RigidBody& b = sim.bodies()->body(1);
+  const double a0 = a.position().x(), b0 = b.position().x();
+  while (sim.time() < end) {
+    sim.step();
+    most_substeps = std::max(most_substeps, sim.bodies()->last_substeps());
+    const auto* x = st.data<float>(ids.position);
+    const auto* kind = st.data<std::uint8_t>(ids.kind);
+    const auto* body = st.data<std::uint8_t>(ids.body);
+    std::vector<std::size_t> p0, p1;
+    double wall = -1e9;
+    for (std::size_t i = 0; i < st.size(); ++i) {
+      if (kind[i] != 2) continue;
+      (body[i] == 0 ? p0 : p1).push_back(i);
+      const double d = std::min({double(x[2 * i]), double(x[2 * i + 1]), 0.8 - x[2 * i], 0.5 - x[2 * i + 1]});
+      wall = std::max(wall, 0.5 * dx - d);
+    }
+    double closest = 1e9;
+    for (std::size_t i : p0)
+      for (std::size_t j : p1)
+        closest = std::min(closest, std::hypot(double(x[2 * i] - x[2 * j]), double(x[2 * i + 1] - x[2 * j + 1])));
+    worst_pair = std::max(worst_pair, dx - closest);
+    worst_wall = std::max(worst_wall, wall);
+    if (closest < dx) ++touched_pair;
+    if (b.position().x() > 0.8 - 0.03 - 0.5 * dx) ++touched_wall;
+  }
+  std::printf("[ measured ] dam break on two boxes: moved %.4f m and %.4f m; steps touching each other %d, the right "
+              "wall %d; body-body overlap <= %.3e m (%.4f dx), body-wall <= %.3e m (%.4f dx); up to %d substeps, "
+              "%llu steps\n",
+              a.position().x() - a0, b.position().x() - b0, touched_pair, touched_wall, worst_pair, worst_pair / dx,
+              worst_wall, worst_wall / dx, most_substeps, static_cast<unsigned long long>(sim.steps()));
+  EXPECT_GT(touched_pair, 10) << "the flow should push the first box against the second";
+  EXPECT_LE(worst_pair, 0.1 * dx);
+  EXPECT_LE(worst_wall, 0.1 * dx);
 }
 
 }  // namespace
