@@ -98,8 +98,8 @@ class BodyContacts {
   bool any() const { return active_count_ > 0; }
   const BodyContactShape& shape(std::size_t k) const { return shapes_[k]; }
 
-  // Adds the contact wrench on every body to `out` (one per structure), and the contact force alone
-  // to `contact_out` when given. `dt` advances the tangential springs (0: evaluate only).
+  // Adds the contact wrench on every body to `out` (one per structure, about its centre of mass).
+  // `dt` advances the tangential springs (0: evaluate only, as at the start of a step's substeps).
   void evaluate(const std::vector<std::optional<RigidBody>>& bodies, double dt, std::vector<Wrench>& out);
 
   // The largest stable body substep [s]: t_c / 50 of the stiffest contact each body may meet (see

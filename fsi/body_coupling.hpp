@@ -14,7 +14,7 @@
 // Constraints and contacts (body_constraints.hpp, body_contacts.hpp) are fast forces: a stiff
 // contact lasts a few milliseconds and needs ~50 steps, a mooring spring may be stiffer than the
 // fluid step resolves. With any of them the drift becomes n body substeps of size h = dt / n
-// (multiple time stepping, r-RESPA: Tuckerman, Berne & Martyna, J. Chem. Phys. 97, 1990, 1992):
+// (multiple time stepping, r-RESPA: Tuckerman, Berne & Martyna, J. Chem. Phys. 97, 1990 (1992)):
 //   after the fluid's half-kick:  kick(dt/2) with the slow load (fluid + gravity) only;
 //   after the fluid's drift:      n times { kick(h/2, fast); drift(h); fast at the new state;
 //                                 kick(h/2, fast) }, the fast load (springs, pivots, contacts)
