@@ -550,4 +550,52 @@ domain: {min: [-0.5, -0.5, -0.5], max: [3.5, 1.5, 2.0]}
   EXPECT_EQ(off_axis, 0.0);
 }
 
+
+// The design card's case in 2D (scenes/moored_pipe_dam_break_2d.yaml): a pipe on two moorings struck
+// by a dam break runs to its end with finite loads, and where the flow presses it onto the bed the
+// contact holds it there: its surface dips below the bed by less than 0.1 dx. Water particles DO get
+// inside this moving pipe at the impact (t ~ 0.39 s, before it reaches the bed; a fixed pipe in the
+// same flow keeps them out): printed here and reported in docs/validation.md C as an open problem of
+// the moving-body boundary, not asserted.
+TEST(BodyContacts, MooredPipeStruckByADamBreak) {
+  fsi::Scene scene = tools::read_scene_file(std::string(TURBID_SOURCE_DIR) + "/scenes/moored_pipe_dam_break_2d.yaml");
+  const double dx = scene.particle_spacing, R = 0.05, end = scene.end_time;
+  fsi::Simulation sim(std::move(scene), cpu());
+  sim.start();
+  const auto& st = sim.store();
+  const auto& ids = sim.fields();
+  const fsi::RigidBody& pipe = sim.bodies()->body(0);
+  const Eigen::Vector3d x0 = pipe.position();
+  double closest = 1e9, lowest = 1e9, largest_force = 0, largest_shift = 0, first_inside = -1, bed_gap_then = 0;
+  bool finite = true;
+  while (sim.time() < end) {
+    sim.step();
+    const auto* x = st.data<float>(ids.position);
+    const auto* kind = st.data<std::uint8_t>(ids.kind);
+    const Eigen::Vector3d c = pipe.position();
+    for (std::size_t i = 0; i < st.size(); ++i)
+      if (kind[i] == 0) closest = std::min(closest, std::hypot(x[2 * i] - c.x(), x[2 * i + 1] - c.y()));
+    lowest = std::min(lowest, c.y() - R);
+    if (first_inside < 0 && closest < R - 0.5 * dx) {
+      first_inside = sim.time();
+      bed_gap_then = c.y() - R;
+    }
+    const fsi::Wrench& f = sim.bodies()->fluid_load(0);
+    finite = finite && f.force.allFinite() && f.torque.allFinite() && c.allFinite();
+    largest_force = std::max(largest_force, f.force.norm());
+    largest_shift = std::max(largest_shift, (c - x0).norm());
+  }
+  std::printf("[ measured ] moored pipe in a dam break to t = %.2f s (%llu steps): nearest water particle %.4f m from the "
+              "axis (R = %.2f m, %.2f dx inside the surface at most), lowest surface point %.4f m, largest fluid force "
+              "%.1f N/m, largest displacement %.4f m\n",
+              sim.time(), static_cast<unsigned long long>(sim.steps()), closest, R, (R - closest) / dx, lowest,
+              largest_force, largest_shift);
+  if (first_inside >= 0)
+    std::printf("[ measured ] first water particle inside the pipe at t = %.4f s, the pipe %.2e m above the bed then\n",
+                first_inside, bed_gap_then);
+  EXPECT_TRUE(finite);
+  EXPECT_GT(largest_force, 10.0) << "the wave should have struck the pipe";
+  EXPECT_GT(lowest, -0.1 * dx);
+}
+
 }  // namespace
