@@ -1,12 +1,39 @@
 // Rigid bodies in the fluid's time step; see body_coupling.hpp.
 #include "fsi/body_coupling.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace turbid::fsi {
 
 BodyCoupling::BodyCoupling(std::vector<std::optional<RigidBody>> bodies, const Eigen::Vector3d& gravity)
-    : bodies_(std::move(bodies)), gravity_(gravity), fluid_(bodies_.size()), placement_(bodies_.size()) {}
+    : bodies_(std::move(bodies)),
+      gravity_(gravity),
+      fluid_(bodies_.size()),
+      placement_(bodies_.size()),
+      contact_mean_(bodies_.size()) {}
+
+void BodyCoupling::set_fast_forces(std::vector<BodyConstraint> constraints, std::unique_ptr<BodyContacts> contacts) {
+  constraints_ = std::move(constraints);
+  contacts_ = contacts && contacts->any() ? std::move(contacts) : nullptr;
+}
+
+std::vector<Wrench> BodyCoupling::fast_load(double dt, std::vector<Wrench>* contact) {
+  std::vector<Wrench> load(bodies_.size());
+  for (const auto& c : constraints_) add_constraint_wrench(c, bodies_, load);
+  if (contacts_) {
+    std::vector<Wrench> touch(bodies_.size());
+    contacts_->evaluate(bodies_, dt, touch);
+    for (std::size_t k = 0; k < load.size(); ++k) load[k] += touch[k];
+    if (contact) *contact = std::move(touch);
+  } else if (contact) {
+    contact->assign(bodies_.size(), Wrench{});
+  }
+  return load;
+}
 
 Wrench BodyCoupling::total_load(std::size_t k) const {
   Wrench w = fluid_[k];
@@ -39,8 +66,54 @@ void BodyCoupling::after_kick(sph::Backend& backend, double half_dt) {
 }
 
 void BodyCoupling::after_drift(sph::Backend& backend, double dt) {
-  for (auto& b : bodies_)
-    if (b) b->drift(dt);
+  if (!has_fast_forces()) {
+    for (auto& b : bodies_)
+      if (b) b->drift(dt);
+    place(backend, true);
+    return;
+  }
+  // The substep: the smallest of the constraints' and contacts' limits (body_constraints.hpp,
+  // body_contacts.hpp), at the state after the slow half-kick.
+  double h = dt;
+  for (const auto& c : constraints_) h = std::min(h, constraint_substep(c, bodies_));
+  if (contacts_) {
+    std::vector<Wrench> slow(bodies_.size());
+    for (std::size_t k = 0; k < bodies_.size(); ++k) slow[k] = total_load(k);
+    h = std::min(h, contacts_->max_substep(bodies_, slow, gravity_.norm()));
+  }
+  constexpr double kMaxSubsteps = 100000;
+  const double wanted = std::ceil(dt / h);
+  if (!(wanted <= kMaxSubsteps))
+    throw std::runtime_error("the body contacts or constraints need " + std::to_string(wanted) +
+                             " substeps in a fluid step of " + std::to_string(dt) +
+                             " s; lower the contacts' youngs_modulus or the constraints' stiffness");
+  const int n = std::max(1, int(wanted));
+  const double sub = dt / n;
+  std::vector<Wrench> contact, impulse(bodies_.size());
+  std::vector<Wrench> fast = fast_load(0.0, &contact);
+  last_max_overlap_ = contacts_ ? contacts_->last_max_overlap() : 0.0;
+  for (int s = 0; s < n; ++s) {
+    for (std::size_t k = 0; k < bodies_.size(); ++k) {
+      if (!bodies_[k]) continue;
+      bodies_[k]->kick(0.5 * sub, fast[k]);
+      impulse[k].force += 0.5 * sub * contact[k].force;
+      impulse[k].torque += 0.5 * sub * contact[k].torque;
+      bodies_[k]->drift(sub);
+    }
+    fast = fast_load(sub, &contact);
+    if (contacts_) last_max_overlap_ = std::max(last_max_overlap_, contacts_->last_max_overlap());
+    for (std::size_t k = 0; k < bodies_.size(); ++k) {
+      if (!bodies_[k]) continue;
+      bodies_[k]->kick(0.5 * sub, fast[k]);
+      impulse[k].force += 0.5 * sub * contact[k].force;
+      impulse[k].torque += 0.5 * sub * contact[k].torque;
+    }
+  }
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    contact_mean_[k].force = impulse[k].force / dt;
+    contact_mean_[k].torque = impulse[k].torque / dt;
+  }
+  last_substeps_ = n;
   place(backend, true);
 }
 

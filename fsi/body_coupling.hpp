@@ -10,12 +10,30 @@
 // So the body's particles carry v(n+1/2) while the fluid's density rate and forces are computed,
 // as the fluid's own particles do. Fixed structures are left alone, and a scene without free
 // bodies never builds one of these (no field, no pass). No I/O here.
+//
+// Constraints and contacts (body_constraints.hpp, body_contacts.hpp) are fast forces: a stiff
+// contact lasts a few milliseconds and needs ~50 steps, a mooring spring may be stiffer than the
+// fluid step resolves. With any of them the drift becomes n body substeps of size h = dt / n
+// (multiple time stepping, r-RESPA: Tuckerman, Berne & Martyna, J. Chem. Phys. 97, 1990 (1992)):
+//   after the fluid's half-kick:  kick(dt/2) with the slow load (fluid + gravity) only;
+//   after the fluid's drift:      n times { kick(h/2, fast); drift(h); fast at the new state;
+//                                 kick(h/2, fast) }, the fast load (springs, pivots, contacts)
+//                                 evaluated at every substep with the fluid load held;
+//   second half-kick:             kick(dt/2) with the new slow load.
+// This is symplectic and time-reversible like the plain step (it reduces to it for n = 1 without
+// fast forces) and keeps the fluid's step: h comes from the contacts' Hertz duration (t_c / 50 at
+// the present approach speeds, BodyContacts::max_substep) and the constraints' periods, so a
+// contact costs body substeps, not fluid steps. Tangential springs advance once per substep.
+// Without constraints and contacts the step is the plain one above, bit for bit.
 #pragma once
+#include <memory>
 #include <optional>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "fsi/body_constraints.hpp"
+#include "fsi/body_contacts.hpp"
 #include "fsi/rigid_body.hpp"
 #include "sph/backend.hpp"
 #include "sph/solver.hpp"
@@ -47,11 +65,32 @@ class BodyCoupling final : public sph::StepCoupling {
   // after the resume needs (the per-particle structure forces are not checkpointed).
   void restore_fluid_load(std::size_t k, const Wrench& w) { fluid_[k] = w; }
 
+  // Fast forces (see above): constraints, and contacts (kept when some body has a contact material).
+  void set_fast_forces(std::vector<BodyConstraint> constraints, std::unique_ptr<BodyContacts> contacts);
+  bool has_fast_forces() const { return !constraints_.empty() || contacts_; }
+  const std::vector<BodyConstraint>& constraints() const { return constraints_; }
+  const BodyContacts* contacts() const { return contacts_.get(); }
+  BodyContacts* contacts() { return contacts_.get(); }
+  // The contact wrench on body k averaged over the last step (its impulse / dt) [N], [N m].
+  const Wrench& contact_load(std::size_t k) const { return contact_mean_[k]; }
+  void restore_contact_load(std::size_t k, const Wrench& w) { contact_mean_[k] = w; }
+  // Body substeps of the last step, and the deepest contact overlap met in it [m].
+  int last_substeps() const { return last_substeps_; }
+  double last_max_overlap() const { return last_max_overlap_; }
+  // The fast load (springs, pivots, contacts) on every structure now; `dt` advances the contacts'
+  // tangential springs (0: evaluate only). `contact` receives the contact part alone when given.
+  std::vector<Wrench> fast_load(double dt, std::vector<Wrench>* contact = nullptr);
+
  private:
   std::vector<std::optional<RigidBody>> bodies_;
   Eigen::Vector3d gravity_;
   std::vector<Wrench> fluid_;
   mutable std::vector<sph::BodyPlacement> placement_;
+  std::vector<BodyConstraint> constraints_;
+  std::unique_ptr<BodyContacts> contacts_;
+  std::vector<Wrench> contact_mean_;
+  int last_substeps_ = 0;
+  double last_max_overlap_ = 0;
 };
 
 }  // namespace turbid::fsi

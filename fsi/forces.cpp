@@ -42,6 +42,7 @@ std::vector<std::string> force_columns(const Scene& scene) {
         cols.push_back(p + "wy [rad/s]");
       }
       cols.push_back(p + "wz [rad/s]");
+      for (const auto& a : axes) cols.push_back(p + "contact_F" + a + f_unit);
     }
   }
   return cols;
@@ -95,6 +96,7 @@ std::vector<double> force_row(const Scene& scene, const std::vector<sph::BodyLoa
         row.push_back(b.angular_velocity[1]);
       }
       row.push_back(b.angular_velocity[2]);
+      for (int a = 0; a < n; ++a) row.push_back(b.contact_force[std::size_t(a)]);
     }
   }
   return row;

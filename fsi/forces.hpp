@@ -15,13 +15,16 @@ struct BodyKinematics {
   std::array<double, 4> orientation{1, 0, 0, 0};  // unit quaternion w, x, y, z (body -> world) [-]
   Vec3d velocity{0, 0, 0};                  // of the centre of mass [m/s]
   Vec3d angular_velocity{0, 0, 0};          // [rad/s]
+  Vec3d contact_force{0, 0, 0};             // DEM contacts, mean over the last step [N] (2D: [N/m])
 };
 
 // Column names with units, e.g. "cylinder.Fx [N/m]" (2D: per metre of depth).
 //   2D: Fx, Fy, Mz;  3D: Fx, Fy, Fz, Mx, My, Mz;  with coefficients also drag, lift, C_D, C_L.
 // A moving structure (motion: free) adds its body's state: 2D x, y [m], qw, qz [-], vx, vy [m/s],
-// wz [rad/s]; 3D x, y, z, qw, qx, qy, qz, vx, vy, vz, wx, wy, wz. Its torque is about its centre of
-// mass.
+// wz [rad/s], contact_Fx, contact_Fy [N/m]; 3D x, y, z, qw, qx, qy, qz, vx, vy, vz, wx, wy, wz,
+// contact_Fx, contact_Fy, contact_Fz [N] (the DEM contact force from walls and other structures,
+// its impulse over the last step / dt; zero without a contact material). Its torque (the fluid's)
+// is about its centre of mass.
 std::vector<std::string> force_columns(const Scene& scene);
 
 // The values of one row, in the order of force_columns. Drag F.e_flow and lift F.e_lift;

@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "fsi/probes.hpp"
+#include "fsi/scene_interactions.hpp"
 #include "geometry/mesh.hpp"
 #include "geometry/primitives.hpp"
 #include "geometry/shapes.hpp"
@@ -555,6 +556,7 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
         mask.translation[a] = !st.lock_translation[a];
         mask.rotation[a] = !st.lock_rotation[a];
       }
+      add_hinge_locks(scene_, fb.structure, mask);
       try {
         rigid[fb.structure].emplace(fb.mass_properties, mask);
       } catch (const std::exception& e) {
@@ -565,7 +567,11 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
       }
     }
     const Eigen::Vector3d g(scene_.gravity[0], scene_.gravity[1], scene_.dimensions == 3 ? scene_.gravity[2] : 0.0);
+    // Constraints and contacts (scene_interactions.hpp), from the bodies at t = 0.
+    std::vector<BodyConstraint> constraints = body_constraints(scene_, rigid);
+    std::unique_ptr<BodyContacts> contacts = body_contacts(scene_, surface_layers_, rigid);
     bodies_ = std::make_unique<BodyCoupling>(std::move(rigid), g);
+    bodies_->set_fast_forces(std::move(constraints), std::move(contacts));
     solver_->set_coupling(bodies_.get());
     // The particles were written at their sampled positions; the placement rounds x_c + R r0 once,
     // as every later step does, so the first step starts from the same kind of positions.
@@ -667,6 +673,13 @@ void Simulation::build_particles() {
     double volume = bodies.back().volume;
     if (st.shape != StructureSpec::Shape::mesh) volume = sample_structure(st, dx, d, 0).volume;
     summary_.structures.push_back({st.name, bodies.back().points.size(), bodies.back().surface_area, volume});
+    // The surface layer, for DEM contacts (scene_interactions.hpp).
+    surface_layers_.emplace_back();
+    for (std::size_t i = 0; i < bodies.back().points.size(); ++i)
+      if (bodies.back().layer[i] == 0) {
+        const auto& p = bodies.back().points[i];
+        surface_layers_.back().emplace_back(p[0], p[1], d == 3 ? p[2] : 0.0);
+      }
   }
   const StructureCarver carver(std::move(solids), dx);
 
@@ -954,6 +967,7 @@ std::vector<BodyKinematics> Simulation::body_kinematics() const {
       out[k].position[std::size_t(a)] = b.position()[a];
       out[k].velocity[std::size_t(a)] = b.velocity()[a];
       out[k].angular_velocity[std::size_t(a)] = w[a];
+      out[k].contact_force[std::size_t(a)] = bodies_->contact_load(k).force[a];
     }
   }
   return out;

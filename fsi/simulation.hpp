@@ -148,6 +148,7 @@ class Simulation {
   sph::ParticleStore store_;
   sph::FieldIds ids_;
   WorldSummary summary_;
+  std::vector<std::vector<Eigen::Vector3d>> surface_layers_;  // per structure, layer 0 at t = 0 (contacts)
   std::unique_ptr<BodyCoupling> bodies_;  // before solver_: the solver points at it
   std::unique_ptr<sph::Solver> solver_;
   std::string backend_name_;

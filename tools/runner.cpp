@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 #include "fsi/forces.hpp"
@@ -76,7 +77,22 @@ nlohmann::json body_states(const fsi::Simulation& sim) {
                     {"velocity", vec(b.velocity())},
                     {"angular_momentum", vec(b.angular_momentum())},
                     {"fluid_force", vec(c.fluid_load(k).force)},
-                    {"fluid_torque", vec(c.fluid_load(k).torque)}});
+                    {"fluid_torque", vec(c.fluid_load(k).torque)},
+                    {"contact_force", vec(c.contact_load(k).force)},
+                    {"contact_torque", vec(c.contact_load(k).torque)}});
+  }
+  return list;
+}
+
+// The DEM contacts open at the checkpoint: key (body, sphere, obstacle kind, obstacle, obstacle
+// sphere) and the tangential spring's elongation, which the next substeps continue from.
+nlohmann::json contact_states(const fsi::Simulation& sim) {
+  nlohmann::json list = nlohmann::json::array();
+  const fsi::BodyContacts* contacts = sim.bodies()->contacts();
+  if (!contacts) return list;
+  for (const auto& [key, spring] : contacts->springs()) {
+    const Eigen::Vector3d& e = spring.elongation;
+    list.push_back(nlohmann::json::array({key[0], key[1], key[2], key[3], key[4], e[0], e[1], e[2]}));
   }
   return list;
 }
@@ -102,6 +118,22 @@ void restore_body_states(fsi::Simulation& sim, const nlohmann::json& state, cons
     w.force = vec(b.at("fluid_force"));
     w.torque = vec(b.at("fluid_torque"));
     c.restore_fluid_load(k, w);
+    if (b.contains("contact_force")) {
+      fsi::Wrench touch;
+      touch.force = vec(b.at("contact_force"));
+      touch.torque = vec(b.at("contact_torque"));
+      c.restore_contact_load(k, touch);
+    }
+  }
+  if (fsi::BodyContacts* contacts = c.contacts()) {
+    std::map<fsi::ContactKey, fsi::TangentialSpring> springs;
+    if (state.contains("contacts"))
+      for (const auto& e : state.at("contacts")) {
+        fsi::ContactKey key;
+        for (std::size_t i = 0; i < 5; ++i) key[i] = e.at(i).get<int>();
+        springs[key].elongation = Eigen::Vector3d(e.at(5).get<double>(), e.at(6).get<double>(), e.at(7).get<double>());
+      }
+    contacts->restore_springs(std::move(springs));
   }
 }
 
@@ -206,6 +238,7 @@ class Writers final : public fsi::Observer {
     // Meshes named relative to the scene file are found from here when the run is resumed.
     state["scene_directory"] = sim.scene().base_directory;
     if (sim.bodies()) state["bodies"] = body_states(sim);
+    if (sim.bodies() && sim.bodies()->contacts()) state["contacts"] = contact_states(sim);
     write_checkpoint(out_ / "checkpoint", sim.store(), state);
   }
 

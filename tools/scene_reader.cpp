@@ -376,6 +376,9 @@ class Reader {
   void read_fluids(const Value& v, fsi::Scene& scene, const std::vector<YAML::Mark>& wall_marks) const;
   void read_structures(const Value& v, fsi::Scene& scene) const;
   void read_motion(const MapView& m, int dims, fsi::StructureSpec& st) const;
+  void read_contact(const Value& v, fsi::ContactMaterialSpec& c) const;
+  void read_constraints(const Value& v, fsi::Scene& scene) const;
+  fsi::ConstraintEndSpec read_constraint_end(const Value& v, const fsi::Scene& scene) const;
   void read_open_boundaries(const Value& v, fsi::Scene& scene) const;
   void read_probes(const Value& v, fsi::Scene& scene) const;
   void read_output(const Value& v, fsi::OutputSpec& out) const;
@@ -450,7 +453,7 @@ Value MapView::need(std::string_view key) const {
 const std::vector<std::string> kTopKeys = {"name",   "dimensions", "resolution", "time",   "gravity",
                                            "numerics", "materials", "walls",     "structures", "fluids",
                                            "open_boundaries", "probes", "output", "domain", "transitions",
-                                           "capacity"};
+                                           "capacity", "constraints"};
 
 fsi::Scene Reader::read(const std::string& yaml_text) {
   std::vector<YAML::Node> documents;
@@ -522,6 +525,7 @@ fsi::Scene Reader::read(const std::string& yaml_text) {
     std::vector<YAML::Mark> wall_marks;
     if (auto v = top.get("walls")) read_walls(*v, scene, wall_marks);
     if (auto v = top.get("structures")) read_structures(*v, scene);
+    if (auto v = top.get("constraints")) read_constraints(*v, scene);
     if (auto v = top.get("open_boundaries")) read_open_boundaries(*v, scene);
     read_fluids(top.need("fluids"), scene, wall_marks);
     if (auto v = top.get("probes")) read_probes(*v, scene);
@@ -882,7 +886,8 @@ void Reader::read_structures(const Value& v, fsi::Scene& scene) const {
   for (const Value& item : list(v)) {
     MapView m(*this, item,
               {"name", "box", "sphere", "cylinder", "mesh", "position", "rotation", "scale", "layers",
-               "reference_point", "coefficients", "motion", "density", "mass", "centre_of_mass", "inertia", "lock"});
+               "reference_point", "coefficients", "motion", "density", "mass", "centre_of_mass", "inertia", "lock",
+               "contact"});
     fsi::StructureSpec st;
     st.where = where(item.mark);
     const Value nv = m.need("name");
@@ -954,6 +959,7 @@ void Reader::read_structures(const Value& v, fsi::Scene& scene) const {
     st.reference_point = st.position;
     if (auto x = m.get("reference_point")) st.reference_point = point(*x, dims, "m");
     read_motion(m, dims, st);
+    if (auto cv = m.get("contact")) read_contact(*cv, st.contact);
     if (auto cv = m.get("coefficients")) {
       MapView c(*this, *cv, {"flow_direction", "lift_direction", "velocity", "density", "length", "area"}, false);
       if (dims == 2 && c.has("area"))
@@ -1068,6 +1074,127 @@ void Reader::read_motion(const MapView& m, int dims, fsi::StructureSpec& st) con
       if (name[0] == 'r') st.lock_rotation[std::size_t(name[1] - 'x')] = true;
       else st.lock_translation[std::size_t(name[0] - 'x')] = true;
     }
+  }
+}
+
+// contact: {youngs_modulus, poisson_ratio, restitution, friction}: the DEM contact material of a
+// structure (fsi/body_contacts.hpp). On a moving structure it turns its contacts on; on a fixed one
+// it is the obstacle's material (without it a fixed structure is rigid).
+void Reader::read_contact(const Value& v, fsi::ContactMaterialSpec& c) const {
+  MapView m(*this, v, {"youngs_modulus", "poisson_ratio", "restitution", "friction"});
+  c.given = true;
+  c.where = where(v.mark);
+  c.youngs_modulus = number(m.need("youngs_modulus"), positive(), "Pa");
+  if (auto x = m.get("poisson_ratio"))
+    c.poisson_ratio = number(*x, {"a number in [0, 0.5]", [](double p) { return p >= 0 && p <= 0.5; }});
+  c.restitution = number(m.need("restitution"), open_closed(0.0, 1.0));
+  c.friction = number(m.need("friction"), non_negative());
+}
+
+// One end of a constraint: {structure: name, point: [..]} (a point of a moving structure, world
+// position at t = 0) or {anchor: [..]} (fixed in the world).
+fsi::ConstraintEndSpec Reader::read_constraint_end(const Value& v, const fsi::Scene& scene) const {
+  const int dims = scene.dimensions;
+  MapView m(*this, v, {"structure", "point", "anchor"});
+  fsi::ConstraintEndSpec end;
+  if (m.has("structure") == m.has("anchor"))
+    fail(v.mark, v.name + " needs either 'structure' (with 'point') or 'anchor', " +
+                     std::string(m.has("anchor") ? "not both" : "found neither"));
+  if (auto av = m.get("anchor")) {
+    if (m.has("point"))
+      fail(m.key_mark("point"), "'point' applies to a structure end; an 'anchor' is itself the point [m]");
+    end.point = point(*av, dims, "m");
+    return end;
+  }
+  const Value sv = m.need("structure");
+  const std::string name = text(sv);
+  std::vector<std::string> names;
+  for (const auto& st : scene.structures) names.push_back(st.name);
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it == names.end())
+    fail(sv.mark, "unknown structure '" + name + "'" + did_you_mean(name, names) +
+                      (names.empty() ? std::string(" (the scene has no structures)")
+                                     : " (defined structures: " + join(names) + ")"));
+  end.structure = int(it - names.begin());
+  const fsi::StructureSpec& st = scene.structures[std::size_t(end.structure)];
+  if (st.motion != fsi::StructureSpec::Motion::free && st.motion != fsi::StructureSpec::Motion::bullet)
+    fail(sv.mark, "structure '" + name + "' is " +
+                      (st.motion == fsi::StructureSpec::Motion::fixed ? "fixed" : "prescribed") +
+                      ": a constraint ties moving structures (motion: free or bullet); tie it to an 'anchor' instead");
+  end.point = point(m.need("point"), dims, "m");
+  return end;
+}
+
+// constraints: springs and hinges between moving structures and fixed anchors (fsi/scene.hpp).
+void Reader::read_constraints(const Value& v, fsi::Scene& scene) const {
+  const int dims = scene.dimensions;
+  const std::vector<Value> items = list(v);
+  if (items.empty()) fail(v.mark, "'constraints' must list at least one constraint (or leave the key out)");
+  std::map<std::string, int> first_line;
+  const std::string per_depth = dims == 2 ? " per metre of depth" : "";
+  for (const Value& item : items) {
+    MapView m(*this, item, {"type", "name", "a", "b", "stiffness", "damping", "rest_length", "axis"}, false);
+    fsi::ConstraintSpec c;
+    c.where = where(item.mark);
+    const Value tv = m.need("type");
+    c.type = choice(tv, {"spring", "hinge"}) == 0 ? fsi::ConstraintSpec::Type::spring : fsi::ConstraintSpec::Type::hinge;
+    const bool spring = c.type == fsi::ConstraintSpec::Type::spring;
+    if (spring && m.has("axis")) fail(m.key_mark("axis"), "'axis' applies to a hinge, not to a spring");
+    if (!spring)
+      for (const char* key : {"stiffness", "damping", "rest_length"})
+        if (m.has(key))
+          fail(m.key_mark(key), "'" + std::string(key) + "' applies to a spring; a hinge holds its two points "
+                                "together and leaves only the turn about its axis free");
+    m.check_keys();
+    c.name = (spring ? "spring_" : "hinge_") + std::to_string(scene.constraints.size() + 1);
+    if (auto nv = m.get("name")) {
+      c.name = text(*nv);
+      if (const auto it = first_line.find(c.name); it != first_line.end())
+        fail(nv->mark, "duplicate constraint name '" + c.name + "' (first used at line " +
+                           std::to_string(it->second) + "); constraint names must be unique");
+      first_line[c.name] = nv->mark.line + 1;
+    }
+    const Value av = m.need("a"), bv = m.need("b");
+    c.a = read_constraint_end(av, scene);
+    c.b = read_constraint_end(bv, scene);
+    if (c.a.structure < 0 && c.b.structure < 0)
+      fail(item.mark, "constraint '" + c.name + "' ties two anchors; at least one end must be a structure");
+    if (c.a.structure >= 0 && c.a.structure == c.b.structure)
+      fail(bv.mark, "constraint '" + c.name + "' ties structure '" + scene.structures[std::size_t(c.a.structure)].name +
+                        "' to itself");
+    if (spring) {
+      c.stiffness = number(m.need("stiffness"), non_negative(), "N/m" + per_depth);
+      if (auto x = m.get("damping")) c.damping = number(*x, non_negative(), "N s/m" + per_depth);
+      if (!(c.stiffness > 0 || c.damping > 0))
+        fail(m.key_mark("stiffness"), "spring '" + c.name + "' has neither stiffness nor damping");
+      if (auto x = m.get("rest_length")) c.rest_length = number(*x, non_negative(), "m");
+    } else if (dims == 2) {
+      if (m.has("axis"))
+        fail(m.key_mark("axis"), "a 2D hinge turns about z, the only axis of a planar body; 'axis' does not apply");
+      c.axis = {0, 0, 1};
+    } else {
+      const Value xv = m.need("axis");
+      Vec3d a = point(xv, 3, "");
+      const double n = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+      if (!(n > 0)) fail(xv.mark, "'axis' must not be the zero vector");
+      for (auto& x : a) x /= n;
+      c.axis = a;
+      // The built-in integrator holds a hinge as a stiff pivot plus rotation locks about world axes
+      // (docs/choices.md); a hinge between two bodies, or about a tilted axis, needs Bullet.
+      const auto moves_free = [&](int s) {
+        return s >= 0 && scene.structures[std::size_t(s)].motion == fsi::StructureSpec::Motion::free;
+      };
+      if (moves_free(c.a.structure) || moves_free(c.b.structure)) {
+        const bool world_axis = std::abs(a[0]) == 1 || std::abs(a[1]) == 1 || std::abs(a[2]) == 1;
+        if (c.a.structure >= 0 && c.b.structure >= 0)
+          fail(item.mark, "hinge '" + c.name + "' joins two structures: the built-in integrator (motion: free) "
+                          "holds a 3D hinge only to an 'anchor'; use 'motion: bullet' for hinges between bodies");
+        if (!world_axis)
+          fail(xv.mark, "hinge '" + c.name + "': the built-in integrator (motion: free) holds a 3D hinge about the "
+                        "x, y or z axis only (it locks the other two rotations); use 'motion: bullet' for a tilted axis");
+      }
+    }
+    scene.constraints.push_back(c);
   }
 }
 

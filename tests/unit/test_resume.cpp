@@ -189,6 +189,19 @@ TEST(CheckpointResume, ResumedRunWithAFreeBodyIsBitIdentical) {
   EXPECT_EQ(r.full.at("status"), "completed");
 }
 
+// A free box resting on the floor with a DEM contact material, on a spring to an anchor (issue #8):
+// the checkpoint also holds the open contacts' tangential springs (the body substeps continue
+// them) and the mean contact force that forces.csv reports.
+TEST(CheckpointResume, ResumedRunWithContactsAndASpringIsBitIdentical) {
+  const auto r = check_resume(std::string(kScene) +
+                              "structures:\n  - {name: box, box: {size: [0.04, 0.04]}, position: [0.32, 0.02], "
+                              "motion: free, density: 800,\n     contact: {youngs_modulus: 1.0e7, restitution: 0.5, "
+                              "friction: 0.4}}\nconstraints:\n  - {type: spring, a: {structure: box, point: [0.33, "
+                              "0.04]}, b: {anchor: [0.38, 0.2]}, stiffness: 50, damping: 0.5}\n");
+  EXPECT_EQ(r.full.at("status"), "completed");
+  EXPECT_FALSE(r.checkpoint_before_resume.at("contacts").empty()) << "the box should be on the floor at the checkpoint";
+}
+
 // Splits before the checkpoint (0.02 s), between it and the stop (0.035 s) and after the resume:
 // the checkpoint holds more particles than the scene builds, some with h/2, and the resumed run
 // must go on splitting exactly as the uninterrupted one (same totals, same capacity).

@@ -163,6 +163,21 @@ const BadScene kBadScenes[] = {
      "3D coefficients without a lift direction (2D takes the in-plane normal)"},
     {"inlet_too_thin.yaml", 11, 34, "less than the kernel support 2h = 0.04 m", "an inlet zone thinner than 2h"},
     {"outlet_velocity.yaml", 11, 84, "'velocity' applies only to an inlet", "an option of inlets given to an outlet"},
+    {"constraint_unknown_structure.yaml", 14, 35, "unknown structure 'pipr'; did you mean 'pipe'?",
+     "a constraint end naming no structure, at the name, with a suggestion"},
+    {"constraint_fixed_structure.yaml", 14, 76, "structure 'post' is fixed: a constraint ties moving structures",
+     "a constraint end on a fixed structure (neither free nor bullet)"},
+    {"constraint_negative_stiffness.yaml", 14, 97, "'stiffness' must be a number >= 0 [N/m per metre of depth], got -100",
+     "a spring of negative stiffness, with its 2D unit"},
+    {"constraint_end_both.yaml", 14, 23, "needs either 'structure' (with 'point') or 'anchor', not both",
+     "an end that is both a structure point and an anchor"},
+    {"hinge_stiffness.yaml", 14, 85, "'stiffness' applies to a spring", "a spring key on a hinge"},
+    {"contact_restitution_range.yaml", 12, 52, "'restitution' must be a number in (0, 1], got 0",
+     "a restitution outside (0, 1]"},
+    {"contact_without_modulus.yaml", 12, 15, "missing required key 'youngs_modulus' in 'contact'",
+     "a contact material without its Young's modulus, at the map"},
+    {"hinge_3d_between_bodies.yaml", 14, 5, "holds a 3D hinge only to an 'anchor'; use 'motion: bullet'",
+     "a built-in 3D hinge between two bodies is refused with a pointer to Bullet"},
 };
 
 class SceneReaderBadFile : public ::testing::TestWithParam<BadScene> {};
@@ -427,3 +442,57 @@ TEST(SceneReader, GoodExtruded3dParsesAndBuilds) {
 }
 
 }  // namespace
+
+// Issue #8: constraints and contact materials parse to the values written (and the documented
+// defaults: rest_length -1 = the distance at t = 0, poisson_ratio 0.3, a 2D hinge about z).
+TEST(SceneReader, ConstraintsAndContactMaterials) {
+  const turbid::fsi::Scene s = read_scene_string(R"(name: moored
+dimensions: 2
+resolution: {particle_spacing: 0.02}
+time: {end: 1.0}
+materials:
+  water: {density: 1000}
+fluids:
+  - {material: water, box: {min: [0, 0], max: [1, 0.5]}}
+structures:
+  - {name: post, box: {size: [0.1, 0.1]}, position: [1.5, 0.2], contact: {youngs_modulus: 2.0e9, restitution: 0.8, friction: 0.6}}
+  - {name: pipe, cylinder: {radius: 0.05}, position: [0.5, 0.7], motion: free, density: 600,
+     contact: {youngs_modulus: 1.0e8, poisson_ratio: 0.25, restitution: 0.5, friction: 0.4}}
+constraints:
+  - type: spring
+    name: left_mooring
+    a: {structure: pipe, point: [0.5, 0.65]}
+    b: {anchor: [0.5, 0.0]}
+    stiffness: 2.0e3
+    damping: 5.0
+  - {type: spring, a: {structure: pipe, point: [0.55, 0.7]}, b: {anchor: [1.0, 0.7]}, stiffness: 10, rest_length: 0.3}
+  - {type: hinge, a: {structure: pipe, point: [0.45, 0.7]}, b: {anchor: [0.45, 0.7]}}
+)",
+                                                     "moored.yaml");
+  ASSERT_EQ(s.constraints.size(), 3u);
+  const auto& m = s.constraints[0];
+  EXPECT_EQ(m.name, "left_mooring");
+  EXPECT_EQ(m.type, turbid::fsi::ConstraintSpec::Type::spring);
+  EXPECT_EQ(m.a.structure, 1);
+  EXPECT_EQ(m.a.point[1], 0.65);
+  EXPECT_EQ(m.b.structure, -1);
+  EXPECT_EQ(m.b.point[0], 0.5);
+  EXPECT_EQ(m.stiffness, 2.0e3);
+  EXPECT_EQ(m.damping, 5.0);
+  EXPECT_EQ(m.rest_length, -1.0);
+  EXPECT_EQ(m.where.line, 14);
+  EXPECT_EQ(s.constraints[1].rest_length, 0.3);
+  EXPECT_EQ(s.constraints[1].name, "spring_2");
+  EXPECT_EQ(s.constraints[2].type, turbid::fsi::ConstraintSpec::Type::hinge);
+  EXPECT_EQ(s.constraints[2].axis[2], 1.0);
+  const auto& post = s.structures[0].contact;
+  EXPECT_TRUE(post.given);
+  EXPECT_EQ(post.youngs_modulus, 2.0e9);
+  EXPECT_EQ(post.poisson_ratio, 0.3);
+  EXPECT_EQ(post.restitution, 0.8);
+  EXPECT_EQ(post.friction, 0.6);
+  const auto& pipe = s.structures[1].contact;
+  EXPECT_EQ(pipe.poisson_ratio, 0.25);
+  EXPECT_EQ(pipe.restitution, 0.5);
+  EXPECT_FALSE(s.constraints.empty());
+}
