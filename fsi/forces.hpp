@@ -11,7 +11,7 @@ namespace turbid::fsi {
 
 // The state of a moving structure's rigid body (world frame).
 struct BodyKinematics {
-  Vec3d position{0, 0, 0};                  // centre of mass [m]
+  Vec3d position{0, 0, 0};                  // centre of mass (prescribed: reference point) [m]
   std::array<double, 4> orientation{1, 0, 0, 0};  // unit quaternion w, x, y, z (body -> world) [-]
   Vec3d velocity{0, 0, 0};                  // of the centre of mass [m/s]
   Vec3d angular_velocity{0, 0, 0};          // [rad/s]
@@ -21,7 +21,8 @@ struct BodyKinematics {
 //   2D: Fx, Fy, Mz;  3D: Fx, Fy, Fz, Mx, My, Mz;  with coefficients also drag, lift, C_D, C_L.
 // A moving structure (motion: free) adds its body's state: 2D x, y [m], qw, qz [-], vx, vy [m/s],
 // wz [rad/s]; 3D x, y, z, qw, qx, qy, qz, vx, vy, vz, wx, wy, wz. Its torque is about its centre of
-// mass.
+// mass. A prescribed structure (motion: prescribed) adds the same columns for its path: x, y (, z)
+// is its moving reference point, about which its torque is taken.
 std::vector<std::string> force_columns(const Scene& scene);
 
 // The values of one row, in the order of force_columns. Drag F.e_flow and lift F.e_lift;

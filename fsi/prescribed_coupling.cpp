@@ -1,0 +1,72 @@
+// Prescribed structures in the fluid's time step; see prescribed_coupling.hpp.
+#include "fsi/prescribed_coupling.hpp"
+
+#include <utility>
+
+namespace turbid::fsi {
+
+bool has_prescribed_structures(const Scene& scene) {
+  for (const auto& st : scene.structures)
+    if (st.motion == StructureSpec::Motion::prescribed) return true;
+  return false;
+}
+
+PrescribedCoupling::PrescribedCoupling(std::vector<std::optional<PrescribedBody>> bodies, std::function<double()> clock)
+    : bodies_(std::move(bodies)), clock_(std::move(clock)), placement_(bodies_.size()) {}
+
+void PrescribedCoupling::place(sph::Backend& backend, double t_position, double t_velocity, bool move) const {
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    sph::BodyPlacement& p = placement_[k];
+    p.moving = bodies_[k].has_value();
+    if (!p.moving) continue;
+    const PrescribedBody& b = *bodies_[k];
+    const PathState at_v = b.path.at(t_velocity);
+    const PathState at_x = t_position == t_velocity ? at_v : b.path.at(t_position);
+    const Eigen::Vector3d centre = b.reference + at_x.displacement;
+    for (int a = 0; a < 3; ++a) {
+      p.centre[a] = centre[a];
+      p.velocity[a] = at_v.velocity[a];
+      p.angular_velocity[a] = at_v.angular_velocity[a];
+      for (int c = 0; c < 3; ++c) p.rotation[a][c] = at_x.rotation(a, c);
+    }
+  }
+  backend.place_bodies(placement_, move);
+}
+
+void PrescribedCoupling::after_kick(sph::Backend& backend, double half_dt) {
+  if (drifted_) {
+    // Second half-kick: the velocity at t(n+1), at the positions already placed.
+    drifted_ = false;
+    place(backend, new_time_, new_time_, false);
+    return;
+  }
+  half_time_ = clock_() + half_dt;
+  place(backend, half_time_, half_time_, false);
+}
+
+void PrescribedCoupling::after_drift(sph::Backend& backend, double dt) {
+  // The solver adds dt to its time after the step: the same sum, the same bits.
+  new_time_ = clock_() + dt;
+  drifted_ = true;
+  place(backend, new_time_, half_time_, true);
+}
+
+Eigen::Vector3d PrescribedCoupling::reference_point(std::size_t k, double t) const {
+  return bodies_[k]->reference + bodies_[k]->path.at(t).displacement;
+}
+
+BodyKinematics PrescribedCoupling::kinematics(std::size_t k, double t) const {
+  BodyKinematics out;
+  const PathState s = bodies_[k]->path.at(t);
+  const Eigen::Vector3d x = bodies_[k]->reference + s.displacement;
+  const Eigen::Quaterniond& q = s.orientation;
+  out.orientation = {q.w(), q.x(), q.y(), q.z()};
+  for (std::size_t a = 0; a < 3; ++a) {
+    out.position[a] = x[int(a)];
+    out.velocity[a] = s.velocity[int(a)];
+    out.angular_velocity[a] = s.angular_velocity[int(a)];
+  }
+  return out;
+}
+
+}  // namespace turbid::fsi
