@@ -284,3 +284,70 @@ TEST(PrescribedCoupling, ParticlesFollowThePathExactly) {
               (unsigned long long)sim.steps(), max_dev, max_vdev, loads[0].force[0], sim.time());
   EXPECT_GT(std::abs(loads[0].force[0]), 0.0) << "the moving cylinder pushes the water";
 }
+
+// A free box falling beside a prescribed cylinder that moves at constant velocity and turns (mDBC):
+// both couplings run in one step (CouplingChain), each placing only its own particles. Reference:
+// the path, as above (1 ulp), and for the mDBC ghost offsets n = R(t) n0 (1 ulp of the offset,
+// 1e-9 m); the free box must have fallen (its velocity below zero).
+TEST(PrescribedCoupling, RunsBesideAFreeBodyWithMdbc) {
+  const char* text = R"(name: prescribed_and_free
+dimensions: 2
+resolution: {particle_spacing: 0.01, smoothing_ratio: 2.0}
+time: {end: 0.03, cfl: 0.2}
+gravity: [0, -9.81]
+numerics: {boundary: {type: mdbc}}
+materials:
+  water: {density: 1000, viscosity: 1.0e-3, sound_speed: 15}
+walls:
+  - box: {min: [0, 0], max: [0.5, 0.4]}
+fluids:
+  - {material: water, box: {min: [0, 0], max: [0.5, 0.3]}}
+structures:
+  - {name: box, box: {size: [0.06, 0.06]}, position: [0.12, 0.35], motion: free, density: 800}
+  - name: rotor
+    box: {size: [0.12, 0.03]}
+    position: [0.32, 0.15]
+    motion: prescribed
+    path: {velocity: [0.2, 0.05], angular_velocity: 180}
+output: {every: 0.03, vtk: false}
+)";
+  auto scene = turbid::tools::read_scene_string(text, "prescribed_and_free.yaml");
+  turbid::fsi::RunOptions opt;
+  opt.backend = "cpu";
+  opt.threads = 1;
+  turbid::fsi::Simulation sim(scene, opt);
+  ASSERT_NE(sim.prescribed(), nullptr);
+  ASSERT_NE(sim.bodies(), nullptr);
+  sim.start();
+  while (sim.time() < 0.03) sim.step();
+  sim.sync_to_host();
+  const PathState s = PrescribedPath(scene.structures[1].path).at(sim.time());
+  const Eigen::Vector3d ref(0.32, 0.15, 0);
+  const auto& ids = sim.fields();
+  const auto& store = sim.store();
+  const auto* x = store.data<float>(ids.position);
+  const auto* r0 = store.data<float>(ids.body_offset);
+  const auto* n = store.data<float>(ids.boundary_normal);
+  const auto* n0 = store.data<float>(ids.body_normal);
+  const auto* kind = store.data<std::uint8_t>(ids.kind);
+  const auto* body = store.data<std::uint8_t>(ids.body);
+  int checked = 0;
+  for (std::size_t i = 0; i < store.size(); ++i) {
+    if (kind[i] != std::uint8_t(turbid::sph::Kind::structure) || body[i] != 1) continue;
+    const Eigen::Vector3d xe = ref + s.displacement + s.rotation * Eigen::Vector3d(r0[2 * i], r0[2 * i + 1], 0);
+    const Eigen::Vector3d ne = s.rotation * Eigen::Vector3d(n0[2 * i], n0[2 * i + 1], 0);
+    for (int a = 0; a < 2; ++a) {
+      EXPECT_LE(std::abs(double(x[2 * i + a]) - xe[a]), std::nextafter(float(xe[a]), 1e9f) - float(xe[a]));
+      EXPECT_LE(std::abs(double(n[2 * i + a]) - ne[a]), 1e-9 + std::abs(std::nextafter(float(ne[a]), 1e9f) - float(ne[a])));
+    }
+    ++checked;
+  }
+  EXPECT_GT(checked, 20);
+  // The path turned the rotor by 180 deg/s x t, and the box, above the water, fell under gravity.
+  EXPECT_NEAR(std::atan2(s.rotation(1, 0), s.rotation(0, 0)), kPi * sim.time(), 1e-12);
+  EXPECT_LT(sim.bodies()->body(0).velocity()[1], 0.0);
+  const auto kin = sim.body_kinematics();
+  EXPECT_EQ(kin[1].position[0], 0.32 + s.displacement[0]);
+  EXPECT_EQ(kin[1].orientation[3], s.orientation.z());
+  EXPECT_EQ(kin[0].position[1], sim.bodies()->body(0).position()[1]);
+}

@@ -3,9 +3,9 @@
 // x = x0 + A (cos wt - 1), A = 0.02 m, T = 1 s, no gravity.
 //
 // Reference: potential flow, F = -C_a rho pi R^2 a(t). C_a = 1 for a circle in unbounded fluid
-// (the circle's added mass rho pi R^2, e.g. Newman, Marine Hydrodynamics, 1977); in this square tank C_a = 1.0712
-// (tools/added_mass_square_tank.py 0.1 0.5: a multipole solution, between the concentric circular
-// tanks' 1.041 and 1.083). The fit: least squares of forces.csv's Fx over t in [T/4, end] against
+// (the circle's added mass rho pi R^2, e.g. Newman, Marine Hydrodynamics, 1977); in this square
+// tank C_a = 1.0712 (tools/added_mass_square_tank.py 0.1 0.5: a multipole solution, between the
+// concentric circular tanks' 1.041 and 1.083). The fit: least squares of forces.csv's Fx over t in [T/4, end] against
 // a(t), v(t) (from the path) and a constant.
 // Tolerance: C_a within 5% of 1.0712. Budget: the Stokes layer adds 4 (pi beta)^-1/2 = 1.1% at
 // beta = D^2 / (nu T) = 4e4 (Wang, J. Fluid Mech. 32, 1968), the water's compressibility about
@@ -13,8 +13,8 @@
 // on a radius of 8 particles a few %. (First planned: 10% about 1.06, the middle of the circular
 // tanks' bracket; set to 5% about the square tank's value once it was computed, with the measured
 // +2.8% in hand; docs/validation.md.) The fit must explain the force: its rms residual below 15% of
-// the force amplitude. Quick mode (CI): dx = 0.0125 m (the scene's), to 1.5 s; full mode
-// (TURBID_FULL=1): dx = 0.00625 m.
+// the force amplitude. Quick mode (CI): the scene's dx = 0.0125 m (R/dx = 8, 30 s of one core),
+// to 1.5 s; full mode (TURBID_FULL=1): dx = 0.00625 m (R/dx = 16, about 10 min).
 #include <gtest/gtest.h>
 
 #include <cmath>
