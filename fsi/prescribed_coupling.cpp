@@ -1,6 +1,7 @@
 // Prescribed structures in the fluid's time step; see prescribed_coupling.hpp.
 #include "fsi/prescribed_coupling.hpp"
 
+#include <algorithm>
 #include <utility>
 
 namespace turbid::fsi {
@@ -9,6 +10,25 @@ bool has_prescribed_structures(const Scene& scene) {
   for (const auto& st : scene.structures)
     if (st.motion == StructureSpec::Motion::prescribed) return true;
   return false;
+}
+
+double first_exit_time(const PrescribedBody& body, const std::vector<Eigen::Vector3d>& offsets, int dims,
+                       const sph::Domain& domain, double end, int count) {
+  std::vector<double> times;
+  for (int j = 0; j <= count; ++j) times.push_back(end * double(j) / double(count));
+  for (double t : body.path.spec().times)
+    if (t > 0 && t < end) times.push_back(t);
+  std::sort(times.begin(), times.end());
+  for (double t : times) {
+    const PathState s = body.path.at(t);
+    const Eigen::Vector3d centre = body.reference + s.displacement;
+    for (const Eigen::Vector3d& r0 : offsets) {
+      const Eigen::Vector3d x = centre + s.rotation * r0;
+      for (int a = 0; a < dims; ++a)
+        if (!domain.periodic[a] && (x[a] < domain.min[a] || x[a] > domain.max[a])) return t;
+    }
+  }
+  return -1;
 }
 
 PrescribedCoupling::PrescribedCoupling(std::vector<std::optional<PrescribedBody>> bodies, std::function<double()> clock)

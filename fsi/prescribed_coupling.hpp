@@ -26,6 +26,7 @@
 #include "fsi/forces.hpp"
 #include "fsi/prescribed_path.hpp"
 #include "sph/backend.hpp"
+#include "sph/grid_layout.hpp"
 #include "sph/solver.hpp"
 
 namespace turbid::fsi {
@@ -36,6 +37,13 @@ struct PrescribedBody {
 };
 
 bool has_prescribed_structures(const Scene& scene);
+
+// The first time in [0, end] at which a particle of the body (its offsets r0 from the reference
+// point) leaves the domain on an axis that is not periodic, or a negative number when none does.
+// Checked at `count` even steps and at the path's sample times: particles that leave the domain are
+// removed from the run, so a path that would carry the structure out is refused before it starts.
+double first_exit_time(const PrescribedBody& body, const std::vector<Eigen::Vector3d>& offsets, int dims,
+                       const sph::Domain& domain, double end, int count = 1000);
 
 class PrescribedCoupling final : public sph::StepCoupling {
  public:

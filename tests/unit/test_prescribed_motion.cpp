@@ -97,7 +97,9 @@ TEST(PrescribedPath, SplineReproducesACubicAndLinearTheChords) {
     EXPECT_NEAR(s.displacement[0], y0 + (y1 - y0) * (tm - t0) / (t1 - t0), 1e-15);
     EXPECT_NEAR(s.velocity[0], (y1 - y0) / (t1 - t0), 1e-13);
     // At a sample time: the interval that starts there.
-    if (i > 0) EXPECT_NEAR(linear.at(t0).velocity[0], (y1 - y0) / (t1 - t0), 1e-13);
+    if (i > 0) {
+      EXPECT_NEAR(linear.at(t0).velocity[0], (y1 - y0) / (t1 - t0), 1e-13);
+    }
   }
 }
 
@@ -350,4 +352,31 @@ output: {every: 0.03, vtk: false}
   EXPECT_EQ(kin[1].position[0], 0.32 + s.displacement[0]);
   EXPECT_EQ(kin[1].orientation[3], s.orientation.z());
   EXPECT_EQ(kin[0].position[1], sim.bodies()->body(0).position()[1]);
+}
+
+// A path that would carry the structure out of the domain (where its particles would be removed)
+// is refused when the run is built, at the path in the scene, with the time it leaves: the cylinder
+// (its right edge at x = 0.25 m) moving at 1 m/s reaches the domain's upper x face (the particles'
+// bounding box, walls included, grown by 4h = 0.08 m: about 0.52 m) near t = 0.27 s, before the
+// end at 0.5 s; to 0.1 s it stays inside.
+TEST(PrescribedCoupling, APathOutOfTheDomainIsRefused) {
+  std::string text = kOscillatingScene;
+  const std::string from = "path: {oscillation: {amplitude: [0.02, 0.005], angular_amplitude: 20, period: 0.1}}";
+  text.replace(text.find(from), from.size(), "path: {velocity: [1, 0]}");
+  text.replace(text.find("time: {end: 0.1"), 15, "time: {end: 0.5");
+  auto scene = turbid::tools::read_scene_string(text, "out.yaml");
+  turbid::fsi::RunOptions opt;
+  opt.backend = "cpu";
+  opt.threads = 1;
+  try {
+    turbid::fsi::Simulation sim(scene, opt);
+    ADD_FAILURE() << "no error for a path out of the domain";
+  } catch (const std::invalid_argument& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind("out.yaml:18:11: error: structure 'cylinder': its path carries it out of the domain at t = ", 0), 0u)
+        << m;
+  }
+  // The same path to 0.1 s stays inside and runs.
+  text.replace(text.find("time: {end: 0.5"), 15, "time: {end: 0.1");
+  EXPECT_NO_THROW(turbid::fsi::Simulation(turbid::tools::read_scene_string(text, "in.yaml"), opt));
 }
