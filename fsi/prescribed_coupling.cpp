@@ -60,8 +60,11 @@ void PrescribedCoupling::after_kick(sph::Backend& backend, double half_dt) {
     place(backend, new_time_, new_time_, false);
     return;
   }
-  half_time_ = clock_() + half_dt;
-  place(backend, half_time_, half_time_, false);
+  // First half-kick: the velocity at t(n) + dt/2 at the particles as they are, R(t(n)) r0 from the
+  // reference point (a free body's kick leaves its orientation too).
+  const double now = clock_();
+  half_time_ = now + half_dt;
+  place(backend, now, half_time_, false);
 }
 
 void PrescribedCoupling::after_drift(sph::Backend& backend, double dt) {

@@ -3,7 +3,8 @@
 // body_coupling.hpp so that the fluid sees a prescribed body exactly as it would see a free body
 // following the same path. With t(n) the solver's time at the start of the step:
 //   after the first half-kick:  the particles take the path's velocity at t(n) + dt/2
-//                               (v = d' + w x R r0), as a free body's carry v(n+1/2);
+//                               (v = d' + w x R r0, R at t(n) where they still are), as a free
+//                               body's carry v(n+1/2);
 //   after the drift:            the particles are placed at t(n+1) = t(n) + dt, x = x_ref + d + R r0,
 //                               keeping the half-step velocity: the density rate and the forces of
 //                               the new step see positions at t(n+1) and velocities at t(n+1/2),
@@ -66,7 +67,8 @@ class PrescribedCoupling final : public sph::StepCoupling {
   BodyKinematics kinematics(std::size_t k, double t) const;
 
  private:
-  // Positions (when `move`) from the path at t_position, velocities at t_velocity.
+  // Positions (when `move`) and the lever arms R r0 of the velocities from the path at t_position;
+  // the velocity and angular velocity at t_velocity.
   void place(sph::Backend& backend, double t_position, double t_velocity, bool move) const;
 
   std::vector<std::optional<PrescribedBody>> bodies_;
