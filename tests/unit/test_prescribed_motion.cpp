@@ -439,3 +439,24 @@ TEST(PrescribedCoupling, KickDriftKickSeesTheHalfStepVelocityAndTheNewPositions)
   EXPECT_GT((path.at(tn + 0.5 * dt).velocity - path.at(tn).velocity).norm(), 1e-4);
   EXPECT_GT((path.at(tn + dt).velocity - path.at(tn + 0.5 * dt).velocity).norm(), 1e-4);
 }
+
+// The shipped scenes with prescribed structures read and build. The paddle's CSV
+// (scenes/paths/piston_stroke.csv) passes through its samples: at t = 0.5 s the stroke
+// S/2 (t/T) (1 - cos(2 pi t/T)) = 0.02 m, written to 6 decimals (reference: the table).
+TEST(PrescribedScenes, OscillatingCylinderAndWavePaddleBuild) {
+  turbid::fsi::RunOptions opt;
+  opt.backend = "cpu";
+  opt.threads = 1;
+  for (const char* name : {"oscillating_cylinder_2d.yaml", "wave_paddle_2d.yaml"}) {
+    SCOPED_TRACE(name);
+    const auto scene = turbid::tools::read_scene_file(std::string(TURBID_SOURCE_DIR) + "/scenes/" + name);
+    turbid::fsi::Simulation sim(scene, opt);
+    EXPECT_NE(sim.prescribed(), nullptr);
+    EXPECT_GT(sim.summary().structure_particles, 50u);
+  }
+  const auto paddle = turbid::tools::read_scene_file(std::string(TURBID_SOURCE_DIR) + "/scenes/wave_paddle_2d.yaml");
+  const PrescribedPath path(paddle.structures[0].path);
+  EXPECT_EQ(paddle.structures[0].path.times.size(), 61u);
+  EXPECT_EQ(path.at(0.5).displacement[0], 0.02);
+  EXPECT_EQ(path.at(10.0).displacement[0], 0.0);  // held at the last sample (t = 3 s, x = 0)
+}
