@@ -2,6 +2,8 @@
 #include "fsi/prescribed_coupling.hpp"
 
 #include <algorithm>
+#include <sstream>
+#include <stdexcept>
 #include <utility>
 
 namespace turbid::fsi {
@@ -29,6 +31,50 @@ double first_exit_time(const PrescribedBody& body, const std::vector<Eigen::Vect
     }
   }
   return -1;
+}
+
+std::unique_ptr<PrescribedCoupling> make_prescribed_coupling(const Scene& scene, const sph::ParticleStore& store,
+                                                             const sph::FieldIds& ids, const sph::Domain& domain,
+                                                             std::function<double()> clock) {
+  const auto fail = [](const StructureSpec& st, const std::string& what) {
+    std::ostringstream os;
+    os << st.path.where.file << ":" << st.path.where.line << ":" << st.path.where.column << ": error: structure '"
+       << st.name << "': " << what;
+    throw std::invalid_argument(os.str());
+  };
+  std::vector<std::optional<PrescribedBody>> paths(scene.structures.size());
+  for (std::size_t k = 0; k < paths.size(); ++k) {
+    const StructureSpec& st = scene.structures[k];
+    if (st.motion != StructureSpec::Motion::prescribed) continue;
+    try {
+      paths[k].emplace(PrescribedBody{PrescribedPath(st.path),
+                                      Eigen::Vector3d(st.reference_point[0], st.reference_point[1], st.reference_point[2])});
+    } catch (const std::exception& e) {
+      fail(st, e.what());
+    }
+  }
+  // A path that carries the structure out of the domain would lose its particles there.
+  const int d = scene.dimensions;
+  const auto* r0 = static_cast<const sph::Real*>(store.raw(ids.body_offset));
+  const auto* body = store.data<std::uint8_t>(ids.body);
+  const auto* kind = store.data<std::uint8_t>(ids.kind);
+  std::vector<std::vector<Eigen::Vector3d>> offsets(paths.size());
+  for (std::size_t i = 0; i < store.size(); ++i)
+    if (kind[i] == std::uint8_t(sph::Kind::structure) && body[i] < paths.size() && paths[body[i]]) {
+      Eigen::Vector3d r = Eigen::Vector3d::Zero();
+      for (int a = 0; a < d; ++a) r[a] = double(r0[i * std::size_t(d) + std::size_t(a)]);
+      offsets[body[i]].push_back(r);
+    }
+  for (std::size_t k = 0; k < paths.size(); ++k) {
+    if (!paths[k]) continue;
+    const double t = first_exit_time(*paths[k], offsets[k], d, domain, scene.end_time);
+    if (t < 0) continue;
+    std::ostringstream os;
+    os << "its path carries it out of the domain at t = " << t
+       << " s (particles that leave the domain are removed); give a larger 'domain' or a shorter path";
+    fail(scene.structures[k], os.str());
+  }
+  return std::make_unique<PrescribedCoupling>(std::move(paths), std::move(clock));
 }
 
 PrescribedCoupling::PrescribedCoupling(std::vector<std::optional<PrescribedBody>> bodies, std::function<double()> clock)

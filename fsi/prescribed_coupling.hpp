@@ -19,6 +19,7 @@
 // moving reference point). No I/O here.
 #pragma once
 #include <functional>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -27,7 +28,9 @@
 #include "fsi/forces.hpp"
 #include "fsi/prescribed_path.hpp"
 #include "sph/backend.hpp"
+#include "sph/fields.hpp"
 #include "sph/grid_layout.hpp"
+#include "sph/particle_store.hpp"
 #include "sph/solver.hpp"
 
 namespace turbid::fsi {
@@ -78,6 +81,14 @@ class PrescribedCoupling final : public sph::StepCoupling {
   double new_time_ = 0;   // t(n) + dt
   mutable std::vector<sph::BodyPlacement> placement_;
 };
+
+// The coupling of a scene's prescribed structures, from the store as built (the structure
+// particles' offsets r0, fields body_offset and body). Throws std::invalid_argument
+// "FILE:LINE:COL: error: structure 'NAME': ..." at the structure's path for a path it cannot follow
+// or one that leaves `domain` before the scene's end time (first_exit_time).
+std::unique_ptr<PrescribedCoupling> make_prescribed_coupling(const Scene& scene, const sph::ParticleStore& store,
+                                                             const sph::FieldIds& ids, const sph::Domain& domain,
+                                                             std::function<double()> clock);
 
 // Runs several couplings in turn (free and prescribed bodies in one scene); each places only its
 // own structures' particles.

@@ -576,48 +576,8 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
     bodies_->place(solver_->backend(), true);
   }
   if (prescribed) {
-    std::vector<std::optional<PrescribedBody>> paths(scene_.structures.size());
-    for (std::size_t k = 0; k < paths.size(); ++k) {
-      const StructureSpec& st = scene_.structures[k];
-      if (st.motion != StructureSpec::Motion::prescribed) continue;
-      try {
-        paths[k].emplace(PrescribedBody{PrescribedPath(st.path), Eigen::Vector3d(st.reference_point[0],
-                                                                                 st.reference_point[1],
-                                                                                 st.reference_point[2])});
-      } catch (const std::exception& e) {
-        std::ostringstream os;
-        os << st.path.where.file << ":" << st.path.where.line << ":" << st.path.where.column << ": error: structure '"
-           << st.name << "': " << e.what();
-        throw std::invalid_argument(os.str());
-      }
-    }
-    // A path that carries the structure out of the domain would lose its particles there.
-    {
-      const int d = scene_.dimensions;
-      const auto* r0 = static_cast<const sph::Real*>(store_.raw(ids_.body_offset));
-      const auto* body = store_.data<std::uint8_t>(ids_.body);
-      const auto* kind = store_.data<std::uint8_t>(ids_.kind);
-      std::vector<std::vector<Eigen::Vector3d>> offsets(paths.size());
-      for (std::size_t i = 0; i < store_.size(); ++i)
-        if (kind[i] == std::uint8_t(sph::Kind::structure) && body[i] < paths.size() && paths[body[i]]) {
-          Eigen::Vector3d r = Eigen::Vector3d::Zero();
-          for (int a = 0; a < d; ++a) r[a] = double(r0[i * std::size_t(d) + std::size_t(a)]);
-          offsets[body[i]].push_back(r);
-        }
-      for (std::size_t k = 0; k < paths.size(); ++k) {
-        if (!paths[k]) continue;
-        const double t = first_exit_time(*paths[k], offsets[k], d, summary_.domain, scene_.end_time);
-        if (t < 0) continue;
-        const StructureSpec& st = scene_.structures[k];
-        std::ostringstream os;
-        os << st.path.where.file << ":" << st.path.where.line << ":" << st.path.where.column << ": error: structure '"
-           << st.name << "': its path carries it out of the domain at t = " << t
-           << " s (particles that leave the domain are removed); give a larger 'domain' or a shorter path";
-        throw std::invalid_argument(os.str());
-      }
-    }
     const sph::Solver* solver = solver_.get();
-    prescribed_ = std::make_unique<PrescribedCoupling>(std::move(paths), [solver] { return solver->time(); });
+    prescribed_ = make_prescribed_coupling(scene_, store_, ids_, summary_.domain, [solver] { return solver->time(); });
     if (bodies_) {
       chain_ = std::make_unique<CouplingChain>();
       chain_->add(bodies_.get());
