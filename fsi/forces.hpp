@@ -11,7 +11,7 @@ namespace turbid::fsi {
 
 // The state of a moving structure's rigid body (world frame).
 struct BodyKinematics {
-  Vec3d position{0, 0, 0};                  // centre of mass [m]
+  Vec3d position{0, 0, 0};                  // centre of mass (prescribed: reference point) [m]
   std::array<double, 4> orientation{1, 0, 0, 0};  // unit quaternion w, x, y, z (body -> world) [-]
   Vec3d velocity{0, 0, 0};                  // of the centre of mass [m/s]
   Vec3d angular_velocity{0, 0, 0};          // [rad/s]
@@ -24,7 +24,9 @@ struct BodyKinematics {
 // wz [rad/s], contact_Fx, contact_Fy [N/m]; 3D x, y, z, qw, qx, qy, qz, vx, vy, vz, wx, wy, wz,
 // contact_Fx, contact_Fy, contact_Fz [N] (the DEM contact force from walls and other structures,
 // its impulse over the last step / dt; zero without a contact material). Its torque (the fluid's)
-// is about its centre of mass.
+// is about its centre of mass. A prescribed structure (motion: prescribed) adds the same columns
+// for its path: x, y (, z) is its moving reference point, about which its torque is taken; its
+// contact columns are zero (prescribed structures take part in no contact yet).
 std::vector<std::string> force_columns(const Scene& scene);
 
 // The values of one row, in the order of force_columns. Drag F.e_flow and lift F.e_lift;

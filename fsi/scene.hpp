@@ -115,6 +115,27 @@ struct ContactMaterialSpec {
   SourceLocation where;
 };
 
+// motion: prescribed (fsi/prescribed_path.hpp): the structure's displacement d(t) from its scene
+// position and its rotation R(t) about its reference point, given as a constant velocity, a
+// sinusoidal oscillation or samples over time. Internal units: m, s, rad (the scene gives degrees).
+struct PrescribedPathSpec {
+  enum class Kind { velocity, oscillation, samples };
+  enum class Interpolation { spline, linear };  // samples: clamped cubic spline (default) or piecewise linear
+  Kind kind = Kind::velocity;
+  Vec3d velocity{0, 0, 0};           // velocity: d(t) = v t [m/s]
+  Vec3d angular_velocity{0, 0, 0};   // velocity: R(t) = exp(t [w]x), w in the world frame [rad/s]
+  Vec3d amplitude{0, 0, 0};          // oscillation: d(t) = A (sin(2 pi t / T + phi) - sin phi) [m]
+  Vec3d angular_amplitude{0, 0, 0};  // oscillation: angles about x, y, z the same way [rad]
+  double period = 0;                 // oscillation: T [s]
+  double phase = 0;                  // oscillation: phi [rad]
+  std::vector<double> times;         // samples: strictly increasing [s]
+  std::vector<Vec3d> displacement;   // samples: d at each time [m]
+  std::vector<Vec3d> angles;         // samples: angles about x, then y, then z (R = Rz Ry Rx) [rad]
+  Interpolation interpolation = Interpolation::spline;
+  std::string source;                // samples: the CSV file they came from (messages); empty: inline
+  SourceLocation where;
+};
+
 // A structure: a solid sampled into boundary particles (kind structure), fixed, free (the built-in
 // rigid-body integrator, fsi/rigid_body.hpp, coupled to the fluid by fsi/body_coupling.hpp),
 // prescribed (moved along a given path) or bullet (moved by the Bullet physics library). The
@@ -159,6 +180,7 @@ struct StructureSpec {
   std::array<bool, 3> lock_translation{false, false, false};  // x, y, z locked
   std::array<bool, 3> lock_rotation{false, false, false};     // rx, ry, rz locked
   ContactMaterialSpec contact;     // moving structures: DEM contacts with walls and other structures
+  PrescribedPathSpec path;         // motion: prescribed; torques about the moving reference point
   SourceLocation where;
 };
 

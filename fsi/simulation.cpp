@@ -515,7 +515,8 @@ MassProperties structure_mass_properties(const Scene& scene, const StructureSpec
 Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::move(scene)) {
   params_ = physics_params(scene_);
   const bool free_bodies = has_free_structures(scene_);
-  ids_ = sph::register_fields(store_, params_, !scene_.structures.empty(), free_bodies);
+  const bool prescribed = has_prescribed_structures(scene_);
+  ids_ = sph::register_fields(store_, params_, !scene_.structures.empty(), free_bodies || prescribed);
   build_particles();
 
   std::unique_ptr<sph::Backend> backend;
@@ -528,7 +529,7 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
     backend = sph::cuda_device_count(&why) > 0 ? sph::make_cuda_backend() : sph::make_cpu_backend(options.threads);
     // A backend without splitting (or moving bodies) hands the scene to the CPU.
     if (!scene_.transitions.empty() && !backend->supports_splitting()) backend = sph::make_cpu_backend(options.threads);
-    if (free_bodies && !backend->supports_moving_bodies()) backend = sph::make_cpu_backend(options.threads);
+    if ((free_bodies || prescribed) && !backend->supports_moving_bodies()) backend = sph::make_cpu_backend(options.threads);
   } else {
     throw std::invalid_argument("unknown backend '" + options.backend + "' (expected auto, cpu or cuda)");
   }
@@ -538,6 +539,9 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
   if (free_bodies && !backend->supports_moving_bodies())
     throw std::invalid_argument("the scene has free structures (motion: free), which the " + backend->name() +
                                 " backend does not run yet; use --backend cpu (or auto)");
+  if (prescribed && !backend->supports_moving_bodies())
+    throw std::invalid_argument("the scene has prescribed structures (motion: prescribed), which the " +
+                                backend->name() + " backend does not run yet; use --backend cpu (or auto)");
   backend_name_ = backend->name();
   threads_ = backend->threads();
   sph::TimeStepParams tp;
@@ -576,6 +580,20 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
     // The particles were written at their sampled positions; the placement rounds x_c + R r0 once,
     // as every later step does, so the first step starts from the same kind of positions.
     bodies_->place(solver_->backend(), true);
+  }
+  if (prescribed) {
+    const sph::Solver* solver = solver_.get();
+    prescribed_ = make_prescribed_coupling(scene_, store_, ids_, summary_.domain, [solver] { return solver->time(); });
+    if (bodies_) {
+      chain_ = std::make_unique<CouplingChain>();
+      chain_->add(bodies_.get());
+      chain_->add(prescribed_.get());
+      solver_->set_coupling(chain_.get());
+    } else {
+      solver_->set_coupling(prescribed_.get());
+    }
+    // Rounded once from x_ref + d(0) + R(0) r0, as every later placement.
+    prescribed_->place_at(solver_->backend(), 0.0);
   }
 }
 
@@ -817,6 +835,8 @@ void Simulation::build_particles() {
     for (const auto& fb : summary_.free_bodies)
       if (fb.structure == b)
         for (int k = 0; k < 3; ++k) centre[std::size_t(k)] = fb.mass_properties.centre_of_mass[k];
+    // A prescribed structure moves and turns about its reference point.
+    if (s.structures[b].motion == StructureSpec::Motion::prescribed) centre = s.structures[b].reference_point;
     for (std::size_t i = 0; i < body.points.size(); ++i) {
       const Point& x = body.points[i];
       const double depth = std::isfinite(global_top) ? std::max(0.0, global_top - height_of(s, x)) : 0.0;
@@ -951,11 +971,20 @@ std::vector<sph::BodyLoad> Simulation::structure_loads() {
     for (std::size_t k = 0; k < reference.size(); ++k)
       if (bodies_->is_free(k))
         for (int a = 0; a < 3; ++a) reference[k][std::size_t(a)] = bodies_->body(k).position()[a];
+  if (prescribed_)
+    for (std::size_t k = 0; k < reference.size(); ++k)
+      if (prescribed_->is_prescribed(k)) {
+        const Eigen::Vector3d x = prescribed_->reference_point(k, time());
+        for (int a = 0; a < 3; ++a) reference[k][std::size_t(a)] = x[a];
+      }
   return solver_->backend().body_loads(reference);
 }
 
 std::vector<BodyKinematics> Simulation::body_kinematics() const {
   std::vector<BodyKinematics> out(scene_.structures.size());
+  if (prescribed_)
+    for (std::size_t k = 0; k < out.size(); ++k)
+      if (prescribed_->is_prescribed(k)) out[k] = prescribed_->kinematics(k, time());
   if (!bodies_) return out;
   for (std::size_t k = 0; k < out.size(); ++k) {
     if (!bodies_->is_free(k)) continue;

@@ -9,6 +9,7 @@
 #include "fsi/body_coupling.hpp"
 #include "fsi/forces.hpp"
 #include "fsi/mass_properties.hpp"
+#include "fsi/prescribed_coupling.hpp"
 #include "fsi/scene.hpp"
 #include "sph/backend.hpp"
 #include "sph/fields.hpp"
@@ -137,6 +138,8 @@ class Simulation {
   // The rigid bodies of the free structures; nullptr when every structure is fixed.
   const BodyCoupling* bodies() const { return bodies_.get(); }
   BodyCoupling* bodies() { return bodies_.get(); }
+  // The prescribed structures' paths; nullptr when none is prescribed.
+  const PrescribedCoupling* prescribed() const { return prescribed_.get(); }
   std::uint64_t forces_index() const { return forces_index_; }
   void sync_to_host() { solver_->backend().sync_to_host(); }
 
@@ -150,6 +153,8 @@ class Simulation {
   WorldSummary summary_;
   std::vector<std::vector<Eigen::Vector3d>> surface_layers_;  // per structure, layer 0 at t = 0 (contacts)
   std::unique_ptr<BodyCoupling> bodies_;  // before solver_: the solver points at it
+  std::unique_ptr<PrescribedCoupling> prescribed_;  // motion: prescribed (prescribed_coupling.hpp)
+  std::unique_ptr<CouplingChain> chain_;            // free and prescribed bodies in one scene
   std::unique_ptr<sph::Solver> solver_;
   std::string backend_name_;
   int threads_ = 1;

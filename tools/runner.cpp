@@ -306,6 +306,39 @@ std::string describe_scene(const fsi::Scene& scene) {
     os << "  structure " << st.name << ": " << st.particles << " particles, surface "
        << st.surface_area << (two_d ? " m (perimeter)" : " m^2") << ", volume " << st.volume
        << (two_d ? " m^2 (area)" : " m^3") << "\n";
+  for (const auto& st : scene.structures) {
+    if (st.motion != fsi::StructureSpec::Motion::prescribed) continue;
+    const auto& p = st.path;
+    const auto vec = [&](const fsi::Vec3d& v, double scale) {
+      std::ostringstream o;
+      o << "(" << v[0] * scale << ", " << v[1] * scale;
+      if (!two_d) o << ", " << v[2] * scale;
+      o << ")";
+      return o.str();
+    };
+    const double deg = 180.0 / 3.14159265358979323846;
+    const auto num = [](double x) {
+      std::ostringstream o;
+      o << x;
+      return o.str();
+    };
+    os << "  prescribed " << st.name << ": ";
+    if (p.kind == fsi::PrescribedPathSpec::Kind::velocity) {
+      os << "velocity " << vec(p.velocity, 1) << " m/s, angular velocity "
+         << (two_d ? num(p.angular_velocity[2] * deg) : vec(p.angular_velocity, deg)) << " deg/s";
+    } else if (p.kind == fsi::PrescribedPathSpec::Kind::oscillation) {
+      os << "oscillation, amplitude " << vec(p.amplitude, 1) << " m, angular amplitude "
+         << (two_d ? num(p.angular_amplitude[2] * deg) : vec(p.angular_amplitude, deg)) << " deg, period "
+         << p.period << " s, phase " << p.phase * deg << " deg";
+    } else {
+      os << p.times.size() << " samples over [" << p.times.front() << ", " << p.times.back() << "] s, "
+         << (p.interpolation == fsi::PrescribedPathSpec::Interpolation::spline ? "clamped spline" : "linear")
+         << (p.source.empty() ? std::string(" (inline)") : " (from " + p.source + ")");
+    }
+    os << "; about (" << st.reference_point[0] << ", " << st.reference_point[1];
+    if (!two_d) os << ", " << st.reference_point[2];
+    os << ") m\n";
+  }
   for (const auto& fb : s.free_bodies) {
     const auto& mp = fb.mass_properties;
     const auto& st = scene.structures[fb.structure];

@@ -5,7 +5,9 @@
 // the YAML node. The first error stops the read: a scene either parses completely or not at all.
 #include "tools/scene_reader.hpp"
 
+#include "fsi/prescribed_path.hpp"
 #include "sph/physics_params.hpp"
+#include "tools/path_csv.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -379,6 +381,7 @@ class Reader {
   void read_contact(const Value& v, fsi::ContactMaterialSpec& c) const;
   void read_constraints(const Value& v, fsi::Scene& scene) const;
   fsi::ConstraintEndSpec read_constraint_end(const Value& v, const fsi::Scene& scene) const;
+  void read_path(const MapView& m, const fsi::Scene& scene, fsi::StructureSpec& st) const;
   void read_open_boundaries(const Value& v, fsi::Scene& scene) const;
   void read_probes(const Value& v, fsi::Scene& scene) const;
   void read_output(const Value& v, fsi::OutputSpec& out) const;
@@ -887,7 +890,7 @@ void Reader::read_structures(const Value& v, fsi::Scene& scene) const {
     MapView m(*this, item,
               {"name", "box", "sphere", "cylinder", "mesh", "position", "rotation", "scale", "layers",
                "reference_point", "coefficients", "motion", "density", "mass", "centre_of_mass", "inertia", "lock",
-               "contact"});
+               "contact", "path"});
     fsi::StructureSpec st;
     st.where = where(item.mark);
     const Value nv = m.need("name");
@@ -960,6 +963,7 @@ void Reader::read_structures(const Value& v, fsi::Scene& scene) const {
     if (auto x = m.get("reference_point")) st.reference_point = point(*x, dims, "m");
     read_motion(m, dims, st);
     if (auto cv = m.get("contact")) read_contact(*cv, st.contact);
+    read_path(m, scene, st);
     if (auto cv = m.get("coefficients")) {
       MapView c(*this, *cv, {"flow_direction", "lift_direction", "velocity", "density", "length", "area"}, false);
       if (dims == 2 && c.has("area"))
@@ -1004,8 +1008,7 @@ void Reader::read_motion(const MapView& m, int dims, fsi::StructureSpec& st) con
   const std::vector<std::string> body_keys = {"density", "mass", "centre_of_mass", "inertia", "lock"};
   if (auto mv = m.get("motion")) {
     const std::size_t k = choice(*mv, {"fixed", "free", "prescribed", "bullet"});
-    if (k == 2)
-      fail(mv->mark, "'motion: prescribed' is not available yet (issue #8); use fixed or free");
+    if (k == 2) st.motion = fsi::StructureSpec::Motion::prescribed;
     if (k == 3)
       fail(mv->mark, "'motion: bullet' is not available yet: Bullet is not built into this turbid (issue #8); "
                      "use 'motion: free' for the built-in rigid-body integrator");
@@ -1016,6 +1019,13 @@ void Reader::read_motion(const MapView& m, int dims, fsi::StructureSpec& st) con
       if (m.has(key))
         fail(m.key_mark(key), "'" + key + "' applies to a moving structure; structure '" + st.name +
                                   "' is fixed (add 'motion: free')");
+    return;
+  }
+  if (st.motion == fsi::StructureSpec::Motion::prescribed) {
+    for (const auto& key : body_keys)
+      if (m.has(key))
+        fail(m.key_mark(key), "'" + key + "' applies to a free structure; structure '" + st.name +
+                                  "' is prescribed: it follows its 'path' whatever its mass");
     return;
   }
   if (m.has("reference_point"))
@@ -1196,6 +1206,120 @@ void Reader::read_constraints(const Value& v, fsi::Scene& scene) const {
     }
     scene.constraints.push_back(c);
   }
+}
+
+// motion: prescribed: the structure's 'path' (fsi/prescribed_path.hpp), exactly one of
+//   velocity: [vx, vy(, vz)] [m/s] and/or angular_velocity: wz (3D [wx, wy, wz]) [deg/s];
+//   oscillation: {amplitude: [m], angular_amplitude: [deg], period: [s], phase: [deg]};
+//   samples: rows [t, x, y, rz] (3D [t, x, y, z, rx, ry, rz]) in s, m, deg;
+//   file: a CSV (tools/path_csv.hpp), relative to the scene file like meshes;
+// with samples and file also interpolation: spline (default) | linear. Displacements are from the
+// scene's 'position', rotations about the reference point; the path must start there at t = 0.
+void Reader::read_path(const MapView& m, const fsi::Scene& scene, fsi::StructureSpec& st) const {
+  const int dims = scene.dimensions;
+  if (st.motion != fsi::StructureSpec::Motion::prescribed) {
+    if (m.has("path"))
+      fail(m.key_mark("path"), "'path' applies to 'motion: prescribed'; structure '" + st.name + "' is " +
+                                   (st.motion == fsi::StructureSpec::Motion::fixed ? "fixed" : "not prescribed"));
+    return;
+  }
+  if (!m.has("path"))
+    fail(m.key_mark("motion"), "prescribed structure '" + st.name + "' needs a 'path': 'velocity' (and/or "
+                               "'angular_velocity'), 'oscillation', 'samples' or 'file'");
+  const Value pv = m.need("path");
+  MapView p(*this, pv, {"velocity", "angular_velocity", "oscillation", "samples", "file", "interpolation"});
+  fsi::PrescribedPathSpec& path = st.path;
+  path.where = where(pv.mark);
+  const double d2r = std::acos(-1.0) / 180.0;
+  std::vector<std::string> kinds;
+  for (const char* k : {"velocity", "angular_velocity", "oscillation", "samples", "file"})
+    if (p.has(k) && !(std::string(k) == "angular_velocity" && p.has("velocity"))) kinds.push_back(k);
+  if (kinds.empty())
+    fail(pv.mark, "'path' needs one of 'velocity' (and/or 'angular_velocity'), 'oscillation', 'samples' or 'file'");
+  if (kinds.size() > 1)
+    fail(p.key_mark(kinds[1]), "'path' has both '" + kinds[0] + "' and '" + kinds[1] + "'; give one kind of path");
+  const std::string& kind = kinds[0];
+  const auto angles = [&](const Value& v, std::string_view unit) {
+    fsi::Vec3d a{0, 0, 0};
+    if (dims == 2) a[2] = number(v, any_number(), unit);
+    else a = point(v, 3, unit);
+    for (auto& x : a) x *= d2r;
+    return a;
+  };
+  if (p.has("interpolation") && kind != "samples" && kind != "file")
+    fail(p.key_mark("interpolation"), "'interpolation' applies to a path of 'samples' or a 'file'");
+  if (kind == "velocity" || kind == "angular_velocity") {
+    path.kind = fsi::PrescribedPathSpec::Kind::velocity;
+    if (auto v = p.get("velocity")) path.velocity = point(*v, dims, "m/s");
+    if (auto w = p.get("angular_velocity")) path.angular_velocity = angles(*w, "deg/s");
+  } else if (kind == "oscillation") {
+    path.kind = fsi::PrescribedPathSpec::Kind::oscillation;
+    const Value ov = p.need("oscillation");
+    MapView o(*this, ov, {"amplitude", "angular_amplitude", "period", "phase"});
+    if (!o.has("amplitude") && !o.has("angular_amplitude"))
+      fail(ov.mark, "'oscillation' needs 'amplitude' [m] and/or 'angular_amplitude' [deg]");
+    if (auto a = o.get("amplitude")) path.amplitude = point(*a, dims, "m");
+    if (auto a = o.get("angular_amplitude")) path.angular_amplitude = angles(*a, "deg");
+    path.period = number(o.need("period"), positive(), "s");
+    if (auto ph = o.get("phase")) path.phase = number(*ph, any_number(), "deg") * d2r;
+  } else {
+    path.kind = fsi::PrescribedPathSpec::Kind::samples;
+    if (auto iv = p.get("interpolation"))
+      path.interpolation = choice(*iv, {"spline", "linear"}) == 0 ? fsi::PrescribedPathSpec::Interpolation::spline
+                                                                  : fsi::PrescribedPathSpec::Interpolation::linear;
+    if (kind == "samples") {
+      const std::size_t n = dims == 2 ? 4 : 7;
+      const std::string shape = dims == 2 ? "[t, x, y, rz] in s, m, m, deg" : "[t, x, y, z, rx, ry, rz] in s, m, m, m, deg, deg, deg";
+      const std::vector<Value> rows = list(p.need("samples"));
+      if (rows.size() < 2)
+        fail(p.need("samples").mark, "'samples' needs at least 2 rows " + shape + ", got " + std::to_string(rows.size()));
+      for (const Value& row : rows) {
+        if (!row.node.IsSequence() || row.node.size() != n)
+          fail(row.mark, row.name + " must be a list of " + std::to_string(n) + " numbers " + shape + ", got " +
+                             describe(row.node));
+        std::vector<double> x(n);
+        for (std::size_t k = 0; k < n; ++k) {
+          const YAML::Node c = row.node[k];
+          x[k] = number({c, c.Mark().is_null() ? row.mark : c.Mark(), "value " + std::to_string(k + 1) + " of " + row.name},
+                        any_number());
+        }
+        if (!path.times.empty() && !(x[0] > path.times.back()))
+          fail(row.mark, "sample times must increase strictly: " + row.name + " has t = " + fmt(x[0]) +
+                             " s after t = " + fmt(path.times.back()) + " s");
+        path.times.push_back(x[0]);
+        if (dims == 2) {
+          path.displacement.push_back({x[1], x[2], 0});
+          path.angles.push_back({0, 0, x[3] * d2r});
+        } else {
+          path.displacement.push_back({x[1], x[2], x[3]});
+          path.angles.push_back({x[4] * d2r, x[5] * d2r, x[6] * d2r});
+        }
+      }
+    } else {
+      const Value fv = p.need("file");
+      path.source = text(fv, "a CSV file name");
+      std::filesystem::path file(path.source);
+      if (file.is_relative()) file = std::filesystem::path(scene.base_directory) / file;
+      const std::string resolved = file.lexically_normal().string();
+      std::error_code ec;
+      if (!std::filesystem::is_regular_file(resolved, ec))
+        fail(fv.mark, "path file '" + path.source + "' not found (looked for " + resolved +
+                          "; relative paths are relative to the scene file)");
+      read_path_csv(resolved, resolved, dims, path);
+    }
+  }
+  // The particles and the fluid around them are built where the scene puts the structure.
+  fsi::PathState s0;
+  try {
+    s0 = fsi::PrescribedPath(path).at(0.0);
+  } catch (const std::exception& e) {
+    fail(pv.mark, e.what());
+  }
+  const double moved = s0.displacement.norm(), turned = (s0.rotation - Eigen::Matrix3d::Identity()).norm();
+  if (moved > 1e-9 || turned > 1e-9)
+    fail(pv.mark, "the path of structure '" + st.name + "' must start where the scene puts it: at t = 0 it is " +
+                      "displaced by " + fmt(moved) + " m and turned by " + fmt(std::acos(std::clamp((s0.rotation.trace() - 1) / 2, -1.0, 1.0)) / d2r) +
+                      " deg; give displacements and angles relative to 'position' and 'rotation' (zero at t = 0)");
 }
 
 void Reader::read_open_boundaries(const Value& v, fsi::Scene& scene) const {

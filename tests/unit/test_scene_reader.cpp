@@ -178,6 +178,16 @@ const BadScene kBadScenes[] = {
      "a contact material without its Young's modulus, at the map"},
     {"hinge_3d_between_bodies.yaml", 14, 5, "holds a 3D hinge only to an 'anchor'; use 'motion: bullet'",
      "a built-in 3D hinge between two bodies is refused with a pointer to Bullet"},
+    {"prescribed_path_typo.yaml", 16, 7, "unknown key 'oscilation' in 'path'; did you mean 'oscillation'?",
+     "a misspelt kind of prescribed path, at its key"},
+    {"prescribed_times.yaml", 19, 11, "sample times must increase strictly: item 3 of 'samples' has t = 0.5 s after "
+     "t = 0.5 s", "inline samples whose times repeat, at the row"},
+    {"prescribed_without_path.yaml", 11, 70, "prescribed structure 'cylinder' needs a 'path'",
+     "motion: prescribed without a path, at its 'motion' key"},
+    {"prescribed_start.yaml", 16, 7, "must start where the scene puts it: at t = 0 it is displaced by 0.05 m",
+     "a path held at a first sample away from the scene position (the fluid is carved around that position)"},
+    {"prescribed_mass.yaml", 11, 90, "'mass' applies to a free structure; structure 'cylinder' is prescribed",
+     "a free body's key on a prescribed structure is not ignored"},
 };
 
 class SceneReaderBadFile : public ::testing::TestWithParam<BadScene> {};
@@ -495,4 +505,69 @@ constraints:
   EXPECT_EQ(pipe.poisson_ratio, 0.25);
   EXPECT_EQ(pipe.restitution, 0.5);
   EXPECT_FALSE(s.constraints.empty());
+// motion: prescribed from a CSV beside the scene (tests/data/paths): the samples in SI units
+// (degrees to radians), interpolation as given, and each CSV error located in the CSV file at its
+// line and column.
+namespace {
+std::string prescribed_scene(const std::string& path_yaml) {
+  return "name: p\ndimensions: 2\nresolution: {particle_spacing: 0.02}\ntime: {end: 1.0}\n"
+         "materials:\n  water: {density: 1000}\nfluids:\n  - {material: water, box: {min: [0, 0], max: [1, 0.5]}}\n"
+         "structures:\n  - {name: paddle, box: {size: [0.04, 0.3]}, position: [0.5, 0.7], motion: prescribed,\n"
+         "     path: " + path_yaml + "}\n";
+}
+}  // namespace
+
+TEST(SceneReader, PrescribedPathFromCsvIsReadInSiUnits) {
+  const std::string name = kData + "/paths/scene.yaml";  // relative CSV names resolve beside it
+  const auto scene = turbid::tools::read_scene_string(prescribed_scene("{file: paddle_2d.csv, interpolation: linear}"), name);
+  const auto& st = scene.structures.at(0);
+  EXPECT_EQ(st.motion, turbid::fsi::StructureSpec::Motion::prescribed);
+  const auto& p = st.path;
+  EXPECT_EQ(p.kind, turbid::fsi::PrescribedPathSpec::Kind::samples);
+  EXPECT_EQ(p.interpolation, turbid::fsi::PrescribedPathSpec::Interpolation::linear);
+  ASSERT_EQ(p.times.size(), 3u);
+  EXPECT_EQ(p.times[1], 0.5);
+  EXPECT_EQ(p.displacement[1][0], 0.05);
+  EXPECT_EQ(p.displacement[2][1], 0.01);
+  EXPECT_DOUBLE_EQ(p.angles[1][2], 2.0 * std::acos(-1.0) / 180.0);  // deg -> rad, to rounding
+  EXPECT_EQ(st.reference_point[1], 0.7);  // turns about its position by default
+}
+
+TEST(SceneReader, PrescribedVelocityAndOscillationAreReadInSiUnits) {
+  const std::string name = kData + "/paths/scene.yaml";
+  auto s = turbid::tools::read_scene_string(prescribed_scene("{velocity: [0.1, -0.2], angular_velocity: 90}"), name);
+  EXPECT_EQ(s.structures[0].path.kind, turbid::fsi::PrescribedPathSpec::Kind::velocity);
+  EXPECT_EQ(s.structures[0].path.velocity[1], -0.2);
+  EXPECT_DOUBLE_EQ(s.structures[0].path.angular_velocity[2], std::acos(-1.0) / 2);  // deg/s -> rad/s
+  s = turbid::tools::read_scene_string(
+      prescribed_scene("{oscillation: {amplitude: [0.02, 0], angular_amplitude: 5, period: 0.8, phase: 90}}"), name);
+  const auto& o = s.structures[0].path;
+  EXPECT_EQ(o.kind, turbid::fsi::PrescribedPathSpec::Kind::oscillation);
+  EXPECT_EQ(o.amplitude[0], 0.02);
+  EXPECT_EQ(o.period, 0.8);
+  EXPECT_DOUBLE_EQ(o.phase, std::acos(-1.0) / 2);
+  EXPECT_DOUBLE_EQ(o.angular_amplitude[2], 5 * std::acos(-1.0) / 180);
+}
+
+TEST(SceneReader, PrescribedPathCsvErrorsNameTheCsvLineAndColumn) {
+  const std::string name = kData + "/paths/scene.yaml";
+  const std::string dir = kData + "/paths/";
+  struct Case {
+    const char* file;
+    int line, column;
+    const char* phrase;
+  };
+  const Case cases[] = {
+      {"bad_number.csv", 3, 6, "expected a number, got '0.05x'"},
+      {"bad_time.csv", 4, 7, "sample times must increase strictly: t = 0.4 s does not follow the previous t = 0.5 s"},
+      {"bad_header.csv", 1, 18, "unknown column 'z [m]' in the path header; a 2D path has the columns time, x, y, rz"},
+      {"bad_unit.csv", 1, 11, "column 'x' must be in metres: 'x [m]', got 'x [mm]'"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.file);
+    const std::string message = error_of_string(prescribed_scene(std::string("{file: ") + c.file + "}"), name);
+    const std::string prefix = dir + c.file + ":" + std::to_string(c.line) + ":" + std::to_string(c.column) + ": error: ";
+    EXPECT_EQ(message.rfind(prefix, 0), 0u) << "expected prefix: " << prefix << "\n  got: " << message;
+    EXPECT_NE(message.find(c.phrase), std::string::npos) << "expected phrase: " << c.phrase << "\n  got: " << message;
+  }
 }
