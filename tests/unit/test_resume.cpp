@@ -200,6 +200,8 @@ TEST(CheckpointResume, ResumedRunWithContactsAndASpringIsBitIdentical) {
                               "0.04]}, b: {anchor: [0.38, 0.2]}, stiffness: 50, damping: 0.5}\n");
   EXPECT_EQ(r.full.at("status"), "completed");
   EXPECT_FALSE(r.checkpoint_before_resume.at("contacts").empty()) << "the box should be on the floor at the checkpoint";
+}
+
 // A prescribed paddle (issue #8) oscillating and turning in the column's face: its path is a function
 // of the solver's time alone, so the checkpoint needs nothing more than the time and the particles;
 // the resumed run must place it at the same times with the same bits (frames, forces.csv with its

@@ -505,6 +505,8 @@ constraints:
   EXPECT_EQ(pipe.poisson_ratio, 0.25);
   EXPECT_EQ(pipe.restitution, 0.5);
   EXPECT_FALSE(s.constraints.empty());
+}
+
 // motion: prescribed from a CSV beside the scene (tests/data/paths): the samples in SI units
 // (degrees to radians), interpolation as given, and each CSV error located in the CSV file at its
 // line and column.
