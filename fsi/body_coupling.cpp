@@ -3,10 +3,25 @@
 
 #include <utility>
 
+#include "fsi/bullet_world.hpp"
+
 namespace turbid::fsi {
 
 BodyCoupling::BodyCoupling(std::vector<std::optional<RigidBody>> bodies, const Eigen::Vector3d& gravity)
     : bodies_(std::move(bodies)), gravity_(gravity), fluid_(bodies_.size()), placement_(bodies_.size()) {}
+
+BodyCoupling::~BodyCoupling() = default;
+
+void BodyCoupling::set_bullet(std::unique_ptr<BulletWorld> world) {
+  bullet_ = std::move(world);  // both at rest at the centres of mass
+}
+
+bool BodyCoupling::is_bullet(std::size_t k) const { return bullet_ && bodies_[k] && bullet_->has(k); }
+
+void BodyCoupling::restored() {
+  for (std::size_t k = 0; k < bodies_.size(); ++k)
+    if (is_bullet(k)) bullet_->read_mirror(k, *bodies_[k]);
+}
 
 Wrench BodyCoupling::total_load(std::size_t k) const {
   Wrench w = fluid_[k];
@@ -35,12 +50,23 @@ void BodyCoupling::place(sph::Backend& backend, bool move) const {
 void BodyCoupling::after_kick(sph::Backend& backend, double half_dt) {
   for (std::size_t k = 0; k < bodies_.size(); ++k)
     if (bodies_[k]) bodies_[k]->kick(half_dt, total_load(k));
+  if (bullet_) {
+    std::vector<Wrench> loads(bodies_.size());
+    for (std::size_t k = 0; k < bodies_.size(); ++k)
+      if (is_bullet(k)) loads[k] = total_load(k);
+    bullet_->kick(half_dt, loads);
+  }
   place(backend, false);
 }
 
 void BodyCoupling::after_drift(sph::Backend& backend, double dt) {
-  for (auto& b : bodies_)
-    if (b) b->drift(dt);
+  for (std::size_t k = 0; k < bodies_.size(); ++k)
+    if (bodies_[k] && !is_bullet(k)) bodies_[k]->drift(dt);
+  if (bullet_) {
+    bullet_->step(dt);
+    for (std::size_t k = 0; k < bodies_.size(); ++k)
+      if (is_bullet(k)) bullet_->write_mirror(k, *bodies_[k]);
+  }
   place(backend, true);
 }
 

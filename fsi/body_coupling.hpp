@@ -10,7 +10,14 @@
 // So the body's particles carry v(n+1/2) while the fluid's density rate and forces are computed,
 // as the fluid's own particles do. Fixed structures are left alone, and a scene without free
 // bodies never builds one of these (no field, no pass). No I/O here.
+//
+// motion: bullet structures (bullet_world.hpp) keep a RigidBody here too, a mirror of Bullet's state
+// that placement, forces.csv and checkpoints read as for free bodies: the mirror is kicked as a free
+// body is (its velocity is the step's synchronised one), while Bullet takes the same two half-kick
+// impulses and integrates at the drift; after Bullet's step the mirror takes Bullet's x, q, v(n+1/2)
+// and L = I w.
 #pragma once
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -22,11 +29,22 @@
 
 namespace turbid::fsi {
 
+class BulletWorld;
+
 class BodyCoupling final : public sph::StepCoupling {
  public:
   // One entry per structure in scene order: a body for a free structure, none for a fixed one.
   // gravity [m/s^2].
   BodyCoupling(std::vector<std::optional<RigidBody>> bodies, const Eigen::Vector3d& gravity);
+  ~BodyCoupling() override;
+
+  // Bullet integrates the structures it has (their entries in `bodies` are then mirrors).
+  void set_bullet(std::unique_ptr<BulletWorld> world);
+  bool is_bullet(std::size_t k) const;
+  BulletWorld* bullet() { return bullet_.get(); }
+  const BulletWorld* bullet() const { return bullet_.get(); }
+  // After a checkpoint restored the mirrors: Bullet takes their state (bullet_world.hpp).
+  void restored();
 
   void after_kick(sph::Backend& backend, double half_dt) override;
   void after_drift(sph::Backend& backend, double dt) override;
@@ -52,6 +70,7 @@ class BodyCoupling final : public sph::StepCoupling {
   Eigen::Vector3d gravity_;
   std::vector<Wrench> fluid_;
   mutable std::vector<sph::BodyPlacement> placement_;
+  std::unique_ptr<BulletWorld> bullet_;
 };
 
 }  // namespace turbid::fsi
