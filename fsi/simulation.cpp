@@ -516,13 +516,15 @@ bool has_bullet_structures(const Scene& scene) {
 
 // The Bullet world of the scene's bullet structures (fsi/bullet_world.hpp), with the mass properties
 // the run uses; their meshes are read again here (the sampling's copy is gone).
-std::unique_ptr<BulletWorld> bullet_world(const Scene& scene, const std::vector<FreeBodySummary>& free_bodies) {
+static std::unique_ptr<BulletWorld> bullet_world(const Scene& scene, const std::vector<FreeBodySummary>& free_bodies) {
   std::vector<std::optional<MassProperties>> mass(scene.structures.size());
   for (const auto& fb : free_bodies) mass[fb.structure] = fb.mass_properties;
   std::vector<geometry::TriangleMesh> meshes(scene.structures.size());
-  for (std::size_t k = 0; k < scene.structures.size(); ++k)
-    if (scene.structures[k].motion == StructureSpec::Motion::bullet && scene.structures[k].shape == StructureSpec::Shape::mesh)
-      meshes[k] = geometry::load_mesh(scene.structures[k].resolved_file);
+  for (std::size_t k = 0; k < scene.structures.size(); ++k) {
+    const StructureSpec& st = scene.structures[k];
+    if (st.motion == StructureSpec::Motion::bullet && st.shape == StructureSpec::Shape::mesh)
+      meshes[k] = geometry::load_mesh(st.resolved_file);
+  }
   return make_bullet_world(scene, mass, meshes);
 }
 
