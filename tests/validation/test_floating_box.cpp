@@ -21,7 +21,7 @@
 // box barely turns).
 // Quick mode (CI): 2D at dx = 0.02 m (10 particles across the box's height) to 4 s; 3D at
 // dx = 0.04 m (6 across) to 2.5 s. Full mode (TURBID_FULL=1): 2D at the scene's dx = 0.01 m; 3D at
-// dx = 0.02 m to 4 s. The 3D draft bound at dx = 0.04 m: see the test.
+// dx = 0.8/30 m (9 across) to 2.5 s. The 3D draft bound at dx = 0.04 m: see the test.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -129,18 +129,19 @@ TEST(FloatingBox2d, BulletBoxSettlesAtTheDraftAndAgreesWithTheFreeBox) {
 }
 
 // 3D: quick mode (CI) at dx = 0.04 m, 6 particles across the box's height, to 2.5 s (about 2.5 heave
-// periods); full mode at dx = 0.02 m to 4 s (not run yet: about 40 times the cost). The 1% is
-// not reached at dx = 0.04 m: the 2D box at a similar resolution (dx = 0.04 m, 5 particles across)
-// settles +2.7% high, against +0.84% at 10 across, so the quick mode asserts 3% of the box height,
-// the resolution's error, and full mode the 1% (docs/validation.md, D7).
+// periods, 90 s of one core per run); full mode at dx = 0.8/30 m, 9 across (every size of the scene
+// a whole number of spacings), to 2.5 s (6.5 min of one core per run). The 1% is not reached
+// at dx = 0.04 m: the 2D box at a similar resolution (dx = 0.04 m, 5 particles across) settles +2.7%
+// high, against +0.84% at 10 across, so the quick mode asserts 3% of the box height, the
+// resolution's error, and full mode the 1% (docs/validation.md, D7).
 TEST(FloatingBox3d, FreeAndBulletBoxesSettleAtTheDraft) {
   const bool bullet = turbid::fsi::bullet_available();
-  const double dx = full_mode() ? 0.02 : 0.04;
-  const double end = full_mode() ? 4.0 : 2.5;
+  const double dx = full_mode() ? 0.8 / 30 : 0.04;
+  const double end = 2.5;
   const double bound = full_mode() ? 0.01 : 0.03;
   const double height = 0.24, expected = 0.3968;
   const Settling f = run_box(scene_path("floating_box_3d"), "floating_box_3d", dx, end, "box.z [m]");
-  std::printf("[ measured ] 3D free: error %.3f%% of the box height (bound %.0f%% at dx = %.2f m)\n",
+  std::printf("[ measured ] 3D free: error %.3f%% of the box height (bound %.0f%% at dx = %.4f m)\n",
               100 * (f.mean - expected) / height, 100 * bound, dx);
   EXPECT_GT(f.hi_all - f.lo_all, 0.005);
   EXPECT_LE(std::abs(f.mean - expected), bound * height);
@@ -148,7 +149,7 @@ TEST(FloatingBox3d, FreeAndBulletBoxesSettleAtTheDraft) {
   const fs::path variant = bullet_variant("floating_box_3d");
   const Settling b = run_box(variant, "floating_box_3d_bullet", dx, end, "box.z [m]");
   fs::remove(variant);
-  std::printf("[ measured ] 3D bullet: error %.3f%% of the box height (bound %.0f%% at dx = %.2f m)\n",
+  std::printf("[ measured ] 3D bullet: error %.3f%% of the box height (bound %.0f%% at dx = %.4f m)\n",
               100 * (b.mean - expected) / height, 100 * bound, dx);
   EXPECT_GT(b.hi_all - b.lo_all, 0.005);
   EXPECT_LE(std::abs(b.mean - expected), bound * height);
