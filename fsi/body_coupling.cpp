@@ -55,18 +55,26 @@ void BodyCoupling::after_kick(sph::Backend& backend, double half_dt) {
     for (std::size_t k = 0; k < bodies_.size(); ++k)
       if (is_bullet(k)) loads[k] = total_load(k);
     bullet_->kick(half_dt, loads);
+    if (!drifted_) {
+      // The step's first half-kick: Bullet steps now by the whole dt (2 half_dt is exact) with the
+      // impulses of this and the last half-kick; the particles carry its half-step velocity, hinge
+      // and contact impulses included, through the continuity pass. Its positions wait for the drift.
+      bullet_->step(2 * half_dt);
+      for (std::size_t k = 0; k < bodies_.size(); ++k)
+        if (is_bullet(k)) bullet_->write_mirror_velocity(k, *bodies_[k]);
+    }
   }
+  drifted_ = false;
   place(backend, false);
 }
 
 void BodyCoupling::after_drift(sph::Backend& backend, double dt) {
   for (std::size_t k = 0; k < bodies_.size(); ++k)
     if (bodies_[k] && !is_bullet(k)) bodies_[k]->drift(dt);
-  if (bullet_) {
-    bullet_->step(dt);
+  if (bullet_)
     for (std::size_t k = 0; k < bodies_.size(); ++k)
       if (is_bullet(k)) bullet_->write_mirror(k, *bodies_[k]);
-  }
+  drifted_ = true;
   place(backend, true);
 }
 

@@ -12,10 +12,11 @@
 // bodies never builds one of these (no field, no pass). No I/O here.
 //
 // motion: bullet structures (bullet_world.hpp) keep a RigidBody here too, a mirror of Bullet's state
-// that placement, forces.csv and checkpoints read as for free bodies: the mirror is kicked as a free
-// body is (its velocity is the step's synchronised one), while Bullet takes the same two half-kick
-// impulses and integrates at the drift; after Bullet's step the mirror takes Bullet's x, q, v(n+1/2)
-// and L = I w.
+// that placement, forces.csv and checkpoints read as for free bodies. Bullet takes the same two
+// half-kick impulses and steps by dt at the step's first half-kick (the load F(n) is known then);
+// the mirror takes Bullet's half-step velocity there (v, L = I w; the particles carry it through the
+// continuity pass) and Bullet's x(n+1), q(n+1) at the drift. The second half-kick kicks the mirror
+// as a free body, so its velocity at the end of a step is the synchronised one.
 #pragma once
 #include <memory>
 #include <optional>
@@ -71,6 +72,7 @@ class BodyCoupling final : public sph::StepCoupling {
   std::vector<Wrench> fluid_;
   mutable std::vector<sph::BodyPlacement> placement_;
   std::unique_ptr<BulletWorld> bullet_;
+  bool drifted_ = false;  // a drift since the last half-kick: the next half-kick is the step's second
 };
 
 }  // namespace turbid::fsi

@@ -26,6 +26,13 @@ void BulletWorld::write_mirror(std::size_t structure, RigidBody& mirror) const {
   mirror.restore_state(s.position, s.orientation, s.velocity, R * mirror.body_inertia() * R.transpose() * s.angular_velocity);
 }
 
+void BulletWorld::write_mirror_velocity(std::size_t structure, RigidBody& mirror) const {
+  const BulletBodyState s = state(structure);
+  const Eigen::Matrix3d R = mirror.orientation().toRotationMatrix();
+  mirror.restore_state(mirror.position(), mirror.orientation(), s.velocity,
+                       R * mirror.body_inertia() * R.transpose() * s.angular_velocity);
+}
+
 void BulletWorld::read_mirror(std::size_t structure, const RigidBody& mirror) {
   BulletBodyState s;
   s.position = mirror.position();

@@ -44,7 +44,8 @@
 // (applyCentralForce / applyTorque, torque about the centre of mass). How this lines up with the
 // fluid's kick-drift-kick step (body_coupling.hpp, docs/choices.md):
 //   - the coupling kicks with the fluid's two half-kicks, (dt_{n-1}/2) F(n) and (dt_n/2) F(n), and
-//     steps Bullet at the drift; Bullet's velocity is then the half-step velocity
+//     steps Bullet right after the second of them (the step's first half-kick, before the fluid's
+//     continuity pass); Bullet's velocity is then the half-step velocity
 //     v(n+1/2) = v(n-1/2) + (dt_{n-1} + dt_n)/2 F(n)/m and x(n+1) = x(n) + dt_n v(n+1/2): symplectic
 //     Euler read on a staggered grid is the leapfrog, the same translation as the built-in KDK step
 //     (to rounding) and second order; weight_by_bullet = false puts m g into the same kicks;
@@ -153,6 +154,8 @@ class BulletWorld {
   // The mirror a RigidBody keeps of a Bullet body (same mass properties): x, q, v exactly as Bullet
   // has them (q converted to turbid's frame), L = R I0 R^T w.
   void write_mirror(std::size_t structure, RigidBody& mirror) const;
+  // Only the velocities (v, L = R I0 R^T w with the mirror's own R), the mirror keeping x and q.
+  void write_mirror_velocity(std::size_t structure, RigidBody& mirror) const;
   // The reverse (a resumed run): Bullet takes the mirror's x, q, v and w = I^-1 L.
   void read_mirror(std::size_t structure, const RigidBody& mirror);
 
