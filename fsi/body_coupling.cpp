@@ -7,6 +7,8 @@
 #include <string>
 #include <utility>
 
+#include "fsi/bullet_world.hpp"
+
 namespace turbid::fsi {
 
 BodyCoupling::BodyCoupling(std::vector<std::optional<RigidBody>> bodies, const Eigen::Vector3d& gravity)
@@ -33,6 +35,19 @@ std::vector<Wrench> BodyCoupling::fast_load(double dt, std::vector<Wrench>* cont
     contact->assign(bodies_.size(), Wrench{});
   }
   return load;
+}
+
+BodyCoupling::~BodyCoupling() = default;
+
+void BodyCoupling::set_bullet(std::unique_ptr<BulletWorld> world) {
+  bullet_ = std::move(world);  // both at rest at the centres of mass
+}
+
+bool BodyCoupling::is_bullet(std::size_t k) const { return bullet_ && bodies_[k] && bullet_->has(k); }
+
+void BodyCoupling::restored() {
+  for (std::size_t k = 0; k < bodies_.size(); ++k)
+    if (is_bullet(k)) bullet_->read_mirror(k, *bodies_[k]);
 }
 
 Wrench BodyCoupling::total_load(std::size_t k) const {
@@ -62,13 +77,33 @@ void BodyCoupling::place(sph::Backend& backend, bool move) const {
 void BodyCoupling::after_kick(sph::Backend& backend, double half_dt) {
   for (std::size_t k = 0; k < bodies_.size(); ++k)
     if (bodies_[k]) bodies_[k]->kick(half_dt, total_load(k));
+  if (bullet_) {
+    std::vector<Wrench> loads(bodies_.size());
+    for (std::size_t k = 0; k < bodies_.size(); ++k)
+      if (is_bullet(k)) loads[k] = total_load(k);
+    bullet_->kick(half_dt, loads);
+    if (!drifted_) {
+      // The step's first half-kick: Bullet steps now by the whole dt (2 half_dt is exact) with the
+      // impulses of this and the last half-kick; the particles carry its half-step velocity, hinge
+      // and contact impulses included, through the continuity pass. Its positions wait for the drift.
+      bullet_->step(2 * half_dt);
+      for (std::size_t k = 0; k < bodies_.size(); ++k)
+        if (is_bullet(k)) bullet_->write_mirror_velocity(k, *bodies_[k]);
+    }
+  }
+  drifted_ = false;
   place(backend, false);
 }
 
 void BodyCoupling::after_drift(sph::Backend& backend, double dt) {
+  // Bullet bodies have stepped at the first half-kick; their mirrors take Bullet's x(n+1), q(n+1).
+  if (bullet_)
+    for (std::size_t k = 0; k < bodies_.size(); ++k)
+      if (is_bullet(k)) bullet_->write_mirror(k, *bodies_[k]);
+  drifted_ = true;
   if (!has_fast_forces()) {
-    for (auto& b : bodies_)
-      if (b) b->drift(dt);
+    for (std::size_t k = 0; k < bodies_.size(); ++k)
+      if (bodies_[k] && !is_bullet(k)) bodies_[k]->drift(dt);
     place(backend, true);
     return;
   }
@@ -94,7 +129,7 @@ void BodyCoupling::after_drift(sph::Backend& backend, double dt) {
   last_max_overlap_ = contacts_ ? contacts_->last_max_overlap() : 0.0;
   for (int s = 0; s < n; ++s) {
     for (std::size_t k = 0; k < bodies_.size(); ++k) {
-      if (!bodies_[k]) continue;
+      if (!bodies_[k] || is_bullet(k)) continue;
       bodies_[k]->kick(0.5 * sub, fast[k]);
       impulse[k].force += 0.5 * sub * contact[k].force;
       impulse[k].torque += 0.5 * sub * contact[k].torque;
@@ -103,7 +138,7 @@ void BodyCoupling::after_drift(sph::Backend& backend, double dt) {
     fast = fast_load(sub, &contact);
     if (contacts_) last_max_overlap_ = std::max(last_max_overlap_, contacts_->last_max_overlap());
     for (std::size_t k = 0; k < bodies_.size(); ++k) {
-      if (!bodies_[k]) continue;
+      if (!bodies_[k] || is_bullet(k)) continue;
       bodies_[k]->kick(0.5 * sub, fast[k]);
       impulse[k].force += 0.5 * sub * contact[k].force;
       impulse[k].torque += 0.5 * sub * contact[k].torque;

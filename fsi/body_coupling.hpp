@@ -25,6 +25,12 @@
 // the present approach speeds, BodyContacts::max_substep) and the constraints' periods, so a
 // contact costs body substeps, not fluid steps. Tangential springs advance once per substep.
 // Without constraints and contacts the step is the plain one above, bit for bit.
+// motion: bullet structures (bullet_world.hpp) keep a RigidBody here too, a mirror of Bullet's state
+// that placement, forces.csv and checkpoints read as for free bodies. Bullet takes the same two
+// half-kick impulses and steps by dt at the step's first half-kick (the load F(n) is known then);
+// the mirror takes Bullet's half-step velocity there (v, L = I w; the particles carry it through the
+// continuity pass) and Bullet's x(n+1), q(n+1) at the drift. The second half-kick kicks the mirror
+// as a free body, so its velocity at the end of a step is the synchronised one.
 #pragma once
 #include <memory>
 #include <optional>
@@ -40,11 +46,22 @@
 
 namespace turbid::fsi {
 
+class BulletWorld;
+
 class BodyCoupling final : public sph::StepCoupling {
  public:
   // One entry per structure in scene order: a body for a free structure, none for a fixed one.
   // gravity [m/s^2].
   BodyCoupling(std::vector<std::optional<RigidBody>> bodies, const Eigen::Vector3d& gravity);
+  ~BodyCoupling() override;
+
+  // Bullet integrates the structures it has (their entries in `bodies` are then mirrors).
+  void set_bullet(std::unique_ptr<BulletWorld> world);
+  bool is_bullet(std::size_t k) const;
+  BulletWorld* bullet() { return bullet_.get(); }
+  const BulletWorld* bullet() const { return bullet_.get(); }
+  // After a checkpoint restored the mirrors: Bullet takes their state (bullet_world.hpp).
+  void restored();
 
   void after_kick(sph::Backend& backend, double half_dt) override;
   void after_drift(sph::Backend& backend, double dt) override;
@@ -91,6 +108,8 @@ class BodyCoupling final : public sph::StepCoupling {
   std::vector<Wrench> contact_mean_;
   int last_substeps_ = 0;
   double last_max_overlap_ = 0;
+  std::unique_ptr<BulletWorld> bullet_;
+  bool drifted_ = false;  // a drift since the last half-kick: the next half-kick is the step's second
 };
 
 }  // namespace turbid::fsi

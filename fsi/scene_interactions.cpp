@@ -127,6 +127,9 @@ std::unique_ptr<BodyContacts> body_contacts(const Scene& scene, const SurfaceLay
   for (std::size_t k = 0; k < scene.structures.size(); ++k) {
     const StructureSpec& st = scene.structures[k];
     if (!bodies[k] || !st.contact.given) continue;
+    if (st.motion == StructureSpec::Motion::bullet)
+      located(st.contact.where, "structure '" + st.name + "': 'contact' (DEM contacts) applies to 'motion: free'; "
+                                "bullet bodies collide with each other through Bullet's own collision detection");
     const RigidBody& b = *bodies[k];
     BodyContactShape& s = shapes[k];
     s.active = true;
@@ -164,7 +167,13 @@ std::unique_ptr<BodyContacts> body_contacts(const Scene& scene, const SurfaceLay
 std::vector<BodyConstraint> body_constraints(const Scene& scene, const std::vector<std::optional<RigidBody>>& bodies) {
   std::vector<BodyConstraint> out;
   const double dx = scene.particle_spacing;
+  const auto bullet = [&](int s) {
+    return s >= 0 && scene.structures[std::size_t(s)].motion == StructureSpec::Motion::bullet;
+  };
   for (const auto& cs : scene.constraints) {
+    // A constraint on a bullet body is Bullet's (bullet_world.hpp), which refuses one that also
+    // ties a free body.
+    if (bullet(cs.a.structure) || bullet(cs.b.structure)) continue;
     BodyConstraint c;
     c.structure_a = cs.a.structure;
     c.structure_b = cs.b.structure;

@@ -11,6 +11,7 @@
 #include <unordered_map>
 #include <utility>
 
+#include "fsi/bullet_world.hpp"
 #include "fsi/probes.hpp"
 #include "fsi/scene_interactions.hpp"
 #include "geometry/mesh.hpp"
@@ -504,8 +505,28 @@ sph::PhysicsParams physics_params(const Scene& scene) {
 
 bool has_free_structures(const Scene& scene) {
   for (const auto& st : scene.structures)
-    if (st.motion == StructureSpec::Motion::free) return true;
+    if (st.motion == StructureSpec::Motion::free || st.motion == StructureSpec::Motion::bullet) return true;
   return false;
+}
+
+bool has_bullet_structures(const Scene& scene) {
+  for (const auto& st : scene.structures)
+    if (st.motion == StructureSpec::Motion::bullet) return true;
+  return false;
+}
+
+// The Bullet world of the scene's bullet structures (fsi/bullet_world.hpp), with the mass properties
+// the run uses; their meshes are read again here (the sampling's copy is gone).
+static std::unique_ptr<BulletWorld> bullet_world(const Scene& scene, const std::vector<FreeBodySummary>& free_bodies) {
+  std::vector<std::optional<MassProperties>> mass(scene.structures.size());
+  for (const auto& fb : free_bodies) mass[fb.structure] = fb.mass_properties;
+  std::vector<geometry::TriangleMesh> meshes(scene.structures.size());
+  for (std::size_t k = 0; k < scene.structures.size(); ++k) {
+    const StructureSpec& st = scene.structures[k];
+    if (st.motion == StructureSpec::Motion::bullet && st.shape == StructureSpec::Shape::mesh)
+      meshes[k] = geometry::load_mesh(st.resolved_file);
+  }
+  return make_bullet_world(scene, mass, meshes);
 }
 
 MassProperties structure_mass_properties(const Scene& scene, const StructureSpec& st) {
@@ -537,7 +558,7 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
     throw std::invalid_argument("the scene has transitions (particle splitting), which the " + backend->name() +
                                 " backend does not run yet; use --backend cpu (or auto)");
   if (free_bodies && !backend->supports_moving_bodies())
-    throw std::invalid_argument("the scene has free structures (motion: free), which the " + backend->name() +
+    throw std::invalid_argument("the scene has free structures (motion: free or bullet), which the " + backend->name() +
                                 " backend does not run yet; use --backend cpu (or auto)");
   if (prescribed && !backend->supports_moving_bodies())
     throw std::invalid_argument("the scene has prescribed structures (motion: prescribed), which the " +
@@ -560,7 +581,7 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
         mask.translation[a] = !st.lock_translation[a];
         mask.rotation[a] = !st.lock_rotation[a];
       }
-      add_hinge_locks(scene_, fb.structure, mask);
+      if (st.motion == StructureSpec::Motion::free) add_hinge_locks(scene_, fb.structure, mask);
       try {
         rigid[fb.structure].emplace(fb.mass_properties, mask);
       } catch (const std::exception& e) {
@@ -576,6 +597,7 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
     std::unique_ptr<BodyContacts> contacts = body_contacts(scene_, surface_layers_, rigid);
     bodies_ = std::make_unique<BodyCoupling>(std::move(rigid), g);
     bodies_->set_fast_forces(std::move(constraints), std::move(contacts));
+    if (has_bullet_structures(scene_)) bodies_->set_bullet(bullet_world(scene_, summary_.free_bodies));
     solver_->set_coupling(bodies_.get());
     // The particles were written at their sampled positions; the placement rounds x_c + R r0 once,
     // as every later step does, so the first step starts from the same kind of positions.
@@ -672,7 +694,7 @@ void Simulation::build_particles() {
       const geometry::TriangleMesh* m = st.shape == StructureSpec::Shape::mesh ? &mesh : nullptr;
       bodies.push_back(sample_structure(st, dx, d, layers, m));
       solids.push_back(structure_solid(st, d, m));
-      if (st.motion == StructureSpec::Motion::free)
+      if (st.motion == StructureSpec::Motion::free || st.motion == StructureSpec::Motion::bullet)
         summary_.free_bodies.push_back({bodies.size() - 1, st.name, mass_properties_of(s, st, m)});
     } catch (const std::exception& e) {
       std::ostringstream os;

@@ -31,7 +31,7 @@ struct StructureSummary {
   double volume = 0;        // of the sampled solid [m^3] (area [m^2] in 2D)
 };
 
-// A free structure's mass properties as the run uses them (sampled or from the scene).
+// A free (or bullet) structure's mass properties as the run uses them (sampled or from the scene).
 struct FreeBodySummary {
   std::size_t structure = 0;  // index in scene.structures
   std::string name;
@@ -72,7 +72,9 @@ class Observer {
 // density (or mass / sampled volume), with the scene's centre of mass (the sampled inertia moved to
 // it by the parallel-axis theorem) and inertia where given. Throws std::invalid_argument.
 MassProperties structure_mass_properties(const Scene& scene, const StructureSpec& st);
+// Structures coupled to the fluid as rigid bodies: motion free or bullet.
 bool has_free_structures(const Scene& scene);
+bool has_bullet_structures(const Scene& scene);
 
 // Resolves scene defaults (automatic sound speed, wall layers) and converts to engine parameters.
 sph::PhysicsParams physics_params(const Scene& scene);

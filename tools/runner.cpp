@@ -12,6 +12,7 @@
 #include <map>
 #include <sstream>
 
+#include "fsi/bullet_world.hpp"
 #include "fsi/forces.hpp"
 #include "fsi/simulation.hpp"
 #include "tools/checkpoint.hpp"
@@ -61,7 +62,8 @@ std::vector<double> fluid_momentum(const fsi::Simulation& sim) {
 }
 
 // Free bodies' exact state for a checkpoint: position, orientation, velocity, angular momentum and
-// the fluid load of the last force pass (the first kick after a resume needs it), as JSON numbers,
+// the fluid load of the last force pass (the first kick after a resume needs it), and for a bullet
+// body Bullet's own exact state (fsi/bullet_world.hpp, exact_state), as JSON numbers,
 // which nlohmann writes with enough digits to read back the same doubles.
 nlohmann::json body_states(const fsi::Simulation& sim) {
   nlohmann::json list = nlohmann::json::array();
@@ -80,6 +82,7 @@ nlohmann::json body_states(const fsi::Simulation& sim) {
                     {"fluid_torque", vec(c.fluid_load(k).torque)},
                     {"contact_force", vec(c.contact_load(k).force)},
                     {"contact_torque", vec(c.contact_load(k).torque)}});
+    if (c.is_bullet(k)) list.back()["bullet_state"] = c.bullet()->exact_state(k);
   }
   return list;
 }
@@ -134,6 +137,13 @@ void restore_body_states(fsi::Simulation& sim, const nlohmann::json& state, cons
         springs[key].elongation = Eigen::Vector3d(e.at(5).get<double>(), e.at(6).get<double>(), e.at(7).get<double>());
       }
     contacts->restore_springs(std::move(springs));
+  }
+  c.restored();  // bullet bodies take their mirrors' restored state, then Bullet's exact one where saved
+  for (std::size_t k = 0; k < c.structure_count(); ++k) {
+    if (!c.is_bullet(k)) continue;
+    for (const auto& b : state.at("bodies"))
+      if (b.at("structure").get<std::string>() == sim.scene().structures[k].name && b.contains("bullet_state"))
+        c.bullet()->restore_exact_state(k, b.at("bullet_state").get<std::vector<double>>());
   }
 }
 
@@ -342,7 +352,8 @@ std::string describe_scene(const fsi::Scene& scene) {
   for (const auto& fb : s.free_bodies) {
     const auto& mp = fb.mass_properties;
     const auto& st = scene.structures[fb.structure];
-    os << "  free body " << fb.name << ": mass " << mp.mass << (two_d ? " kg/m" : " kg") << ", centre of mass ("
+    os << (st.motion == fsi::StructureSpec::Motion::bullet ? "  bullet body " : "  free body ") << fb.name
+       << ": mass " << mp.mass << (two_d ? " kg/m" : " kg") << ", centre of mass ("
        << mp.centre_of_mass[0] << ", " << mp.centre_of_mass[1];
     if (!two_d) os << ", " << mp.centre_of_mass[2];
     os << ") m";

@@ -6,6 +6,7 @@
 #include "tools/scene_reader.hpp"
 
 #include "fsi/prescribed_path.hpp"
+#include "fsi/bullet_world.hpp"
 #include "sph/physics_params.hpp"
 #include "tools/path_csv.hpp"
 
@@ -1001,18 +1002,17 @@ void Reader::read_structures(const Value& v, fsi::Scene& scene) const {
   }
 }
 
-// motion: fixed | free (| prescribed | bullet, refused until they exist) and a free body's mass
-// properties and locks. Keys that only a free body uses are refused on a fixed one, so that a
+// motion: fixed | free | bullet (refused with a clear message when this build has no Bullet)
+// (| prescribed, refused until it exists) and a free or bullet body's mass properties and locks. Keys that only a free body uses are refused on a fixed one, so that a
 // forgotten 'motion: free' does not pass silently.
 void Reader::read_motion(const MapView& m, int dims, fsi::StructureSpec& st) const {
   const std::vector<std::string> body_keys = {"density", "mass", "centre_of_mass", "inertia", "lock"};
   if (auto mv = m.get("motion")) {
     const std::size_t k = choice(*mv, {"fixed", "free", "prescribed", "bullet"});
     if (k == 2) st.motion = fsi::StructureSpec::Motion::prescribed;
-    if (k == 3)
-      fail(mv->mark, "'motion: bullet' is not available yet: Bullet is not built into this turbid (issue #8); "
-                     "use 'motion: free' for the built-in rigid-body integrator");
+    if (k == 3 && !fsi::bullet_available()) fail(mv->mark, std::string("'motion: bullet': ") + fsi::kNoBulletMessage);
     if (k == 1) st.motion = fsi::StructureSpec::Motion::free;
+    if (k == 3) st.motion = fsi::StructureSpec::Motion::bullet;
   }
   if (st.motion == fsi::StructureSpec::Motion::fixed) {
     for (const auto& key : body_keys)
@@ -1028,14 +1028,15 @@ void Reader::read_motion(const MapView& m, int dims, fsi::StructureSpec& st) con
                                   "' is prescribed: it follows its 'path' whatever its mass");
     return;
   }
+  const std::string moving = st.motion == fsi::StructureSpec::Motion::bullet ? "bullet" : "free";
   if (m.has("reference_point"))
-    fail(m.key_mark("reference_point"), "a free structure's torques are about its centre of mass, which moves with "
-                                        "it: 'reference_point' does not apply to 'motion: free'");
+    fail(m.key_mark("reference_point"), "a " + moving + " structure's torques are about its centre of mass, which "
+                                        "moves with it: 'reference_point' does not apply to 'motion: " + moving + "'");
   const bool has_density = m.has("density"), has_mass = m.has("mass");
   if (has_density && has_mass)
-    fail(m.key_mark("mass"), "give either 'density' or 'mass' for free structure '" + st.name + "', not both");
+    fail(m.key_mark("mass"), "give either 'density' or 'mass' for " + moving + " structure '" + st.name + "', not both");
   if (!has_density && !has_mass)
-    fail(m.key_mark("motion"), "free structure '" + st.name + "' needs 'density' [kg/m^3] (mass, centre and inertia "
+    fail(m.key_mark("motion"), moving + " structure '" + st.name + "' needs 'density' [kg/m^3] (mass, centre and inertia "
                                "from its shape) or 'mass' [" + std::string(dims == 2 ? "kg/m" : "kg") + "]");
   if (has_density) st.density = number(m.need("density"), positive(), "kg/m^3");
   if (has_mass) st.mass = number(m.need("mass"), positive(), dims == 2 ? "kg/m" : "kg");

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <iostream>
 
+#include "fsi/bullet_world.hpp"
 #include "sph/backend.hpp"
 #include "sph/config.hpp"
 #include "tools/runner.hpp"
@@ -17,6 +18,9 @@ int cmd_info() {
   std::printf("precision        particle fields float32, conservation sums float64\n");
   std::printf("backends         cpu (OpenMP, %d threads available)", omp_get_max_threads());
   std::printf("%s\n", turbid::sph::cuda_backend_compiled() ? ", cuda (compiled in)" : "");
+  std::printf("rigid bodies     built-in (motion: free)%s\n",
+              turbid::fsi::bullet_available() ? ", Bullet double precision (motion: bullet)"
+                                              : "; no Bullet (motion: bullet refused; install libbullet-dev and rebuild)");
   std::string why;
   const int gpus = turbid::sph::cuda_device_count(&why);
   if (gpus > 0) std::printf("gpus             %s\n", why.c_str());

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <unistd.h>
 
+#include "fsi/bullet_world.hpp"
 #include "tools/runner.hpp"
 
 namespace fs = std::filesystem;
@@ -211,6 +212,17 @@ TEST(CheckpointResume, ResumedRunWithAPrescribedBodyIsBitIdentical) {
                               "structures:\n  - {name: paddle, box: {size: [0.02, 0.1]}, position: [0.12, 0.08], "
                               "motion: prescribed,\n     path: {oscillation: {amplitude: [0.02, 0.005], "
                               "angular_amplitude: 10, period: 0.1}}}\n");
+  EXPECT_EQ(r.full.at("status"), "completed");
+}
+
+// The same with a bullet body (motion: bullet, fsi/bullet_world.hpp): the checkpoint holds the
+// mirror's state and Bullet's own exact state (transform basis and origin, velocities, the impulse
+// gathered since the last Bullet step), which a resume restores, so the run stays bit-identical.
+TEST(CheckpointResume, ResumedRunWithABulletBodyIsBitIdentical) {
+  if (!turbid::fsi::bullet_available()) GTEST_SKIP() << "built without Bullet";
+  const auto r = check_resume(std::string(kScene) +
+                              "structures:\n  - {name: box, box: {size: [0.04, 0.04]}, position: [0.1, 0.1], "
+                              "rotation: 15, motion: bullet, density: 800}\n");
   EXPECT_EQ(r.full.at("status"), "completed");
 }
 

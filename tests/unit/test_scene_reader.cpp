@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "fsi/bullet_world.hpp"
 #include "fsi/simulation.hpp"
 #include "tools/scene_reader.hpp"
 
@@ -138,8 +139,13 @@ const BadScene kBadScenes[] = {
     {"structures.yaml", 11, 31, "mesh file 'meshes/pipe.stl' not found",
      "a missing mesh file is reported at its name, with where it was looked for"},
     {"structure_two_shapes.yaml", 11, 18, "has both 'box' and 'sphere'", "a structure with two shapes"},
-    {"motion_bullet.yaml", 11, 50, "'motion: bullet' is not available yet: Bullet is not built into this turbid",
-     "Bullet motion is refused at its value until Bullet is linked (issue #8)"},
+    // Built with Bullet: a bullet body needs its mass as a free one does; without: refused at its value.
+    turbid::fsi::bullet_available()
+        ? BadScene{"motion_bullet.yaml", 11, 42, "bullet structure 'box' needs 'density' [kg/m^3]",
+                   "a bullet body without density or mass is located at its 'motion' key"}
+        : BadScene{"motion_bullet.yaml", 11, 50,
+                   "'motion: bullet': this turbid was built without Bullet; install libbullet-dev and rebuild",
+                   "Bullet motion is refused at its value in a build without Bullet (issue #8)"},
     {"motion_typo.yaml", 11, 50, "'motion' must be one of", "an unknown motion names the choices"},
     {"free_without_mass.yaml", 11, 42, "free structure 'box' needs 'density' [kg/m^3]",
      "a free body without density or mass is located at its 'motion' key"},
