@@ -26,6 +26,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "fsi/bullet_world.hpp"
 #include "fsi/simulation.hpp"
 #include "tests/validation/validation_support.hpp"
 #include "tools/scene_reader.hpp"
@@ -44,8 +45,14 @@ struct PipeRun {
   bool finite = true;
 };
 
-PipeRun run_pipe(const std::string& scene_name, double dx, double end, double radius, double half_length) {
+PipeRun run_pipe(const std::string& scene_name, double dx, double end, double radius, double half_length,
+                 bool bullet = false) {
   fsi::Scene scene = tools::read_scene_file(std::string(TURBID_SOURCE_DIR) + "/scenes/" + scene_name + ".yaml");
+  if (bullet) {
+    // The same pipe moved by Bullet; Bullet bodies collide through Bullet, so no DEM contact material.
+    scene.structures.at(0).motion = fsi::StructureSpec::Motion::bullet;
+    scene.structures.at(0).contact.given = false;
+  }
   scene.particle_spacing = dx;
   if (end > 0) scene.end_time = end;
   scene.output.vtk = false;
@@ -113,6 +120,16 @@ TEST(ValidationPipelineSprings, DamBreakOnASpringHungPipe2D) {
   const double dx = full ? 0.005 : 0.01;
   const double bound = 10 * kRho * kG * 0.6 * 2 * kRadius;  // H = 0.6 m: 5886 N/m
   const PipeRun r = run_pipe("pipeline_springs_dam_break_2d", dx, 0, kRadius, 0);
+  check(r, 1.2, bound);
+}
+
+// The same with motion: bullet (issue #8: "free and Bullet"); same checks.
+TEST(ValidationPipelineSprings, DamBreakOnASpringHungBulletPipe2D) {
+  if (!fsi::bullet_available()) GTEST_SKIP() << "built without Bullet";
+  const bool full = validation::full_mode();
+  const double dx = full ? 0.005 : 0.01;
+  const double bound = 10 * kRho * kG * 0.6 * 2 * kRadius;
+  const PipeRun r = run_pipe("pipeline_springs_dam_break_2d", dx, 0, kRadius, 0, true);
   check(r, 1.2, bound);
 }
 
