@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/unit/body_test_support.hpp"
 #include "fsi/forces.hpp"
 #include "fsi/simulation.hpp"
 #include "tools/scene_reader.hpp"
@@ -37,15 +38,10 @@
 namespace {
 
 using namespace turbid;
+using test::cpu;
+using test::scene_of;
 
-fsi::RunOptions cpu() {
-  fsi::RunOptions r;
-  r.backend = "cpu";
-  r.threads = 1;
-  return r;
-}
 
-fsi::Scene scene_of(const std::string& yaml) { return tools::read_scene_string(yaml, "test.yaml"); }
 
 // Scene head: 2D, dx = 0.01 m, a closed 0.1 x 0.05 m tank full of water at x = 3 m.
 std::string head(const std::string& name, const std::string& gravity, double end) {

@@ -19,21 +19,18 @@
 #include <cstdio>
 #include <string>
 
+#include "tests/unit/body_test_support.hpp"
 #include "fsi/simulation.hpp"
 #include "tools/scene_reader.hpp"
 
 namespace {
 
 using namespace turbid;
+using test::cpu;
+using test::scene_of;
+using test::replace;
 
-fsi::RunOptions cpu() {
-  fsi::RunOptions r;
-  r.backend = "cpu";
-  r.threads = 1;
-  return r;
-}
 
-fsi::Scene scene_of(const std::string& yaml) { return tools::read_scene_string(yaml, "test.yaml"); }
 
 const char* kPush = R"(
 name: push
@@ -51,9 +48,6 @@ structures:
 domain: {min: [-1, -1], max: [2, 2]}
 )";
 
-std::string replace(std::string s, const std::string& what, const std::string& with) {
-  return s.replace(s.find(what), what.size(), with);
-}
 
 struct Momentum {
   double fluid[2] = {0, 0};
@@ -174,13 +168,7 @@ TEST(BodyCoupling, FreeFallFarFromTheFluidIsExact) {
   const auto& s = sim.store();
   const auto& ids = sim.fields();
   // Each body particle's start, by id.
-  std::vector<double> start(2 * s.size());
-  {
-    const auto* x = s.data<float>(ids.position);
-    const auto* id = s.data<std::uint32_t>(ids.id);
-    for (std::size_t i = 0; i < s.size(); ++i)
-      for (int a = 0; a < 2; ++a) start[2 * id[i] + a] = x[2 * i + a];
-  }
+  const std::vector<double> start = test::positions_by_id_2d(sim);
   const double g = 9.81;
   while (sim.time() < 0.3) sim.step();
   const double t = sim.time();

@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <string>
 
+#include "tests/unit/body_test_support.hpp"
 #include "fsi/bullet_world.hpp"
 #include "fsi/simulation.hpp"
 #include "tools/runner.hpp"
@@ -26,17 +27,10 @@
 namespace {
 
 using namespace turbid;
+using test::cpu;
+using test::replace;
 
-fsi::RunOptions cpu() {
-  fsi::RunOptions r;
-  r.backend = "cpu";
-  r.threads = 1;
-  return r;
-}
 
-std::string replace(std::string s, const std::string& what, const std::string& with) {
-  return s.replace(s.find(what), what.size(), with);
-}
 
 const char* kFall = R"(
 name: fall
@@ -63,13 +57,7 @@ TEST(BulletCoupling, FreeFallFarFromTheFluidIsExact) {
   const Eigen::Vector3d x0 = b.position();
   const auto& s = sim.store();
   const auto& ids = sim.fields();
-  std::vector<double> start(2 * s.size());
-  {
-    const auto* x = s.data<float>(ids.position);
-    const auto* id = s.data<std::uint32_t>(ids.id);
-    for (std::size_t i = 0; i < s.size(); ++i)
-      for (int a = 0; a < 2; ++a) start[2 * id[i] + a] = x[2 * i + a];
-  }
+  const std::vector<double> start = test::positions_by_id_2d(sim);
   const double g = 9.81;
   while (sim.time() < 0.3) sim.step();
   const double t = sim.time();
@@ -207,3 +195,20 @@ TEST(BulletCoupling, WithoutBulletTheSceneIsRefusedAtTheMotion) {
 }
 
 }  // namespace
+
+// A DEM contact material on a bullet body is refused at its value (the scene's line 12, the
+// structure's flow map, column 91 where the contact map starts): the DEM contacts integrate free bodies only, and a contact acting on one
+// side would break Newton's third law (docs/choices.md, "Bullet bodies").
+TEST(BulletCoupling, ContactMaterialOnABulletBodyIsRefusedWhereTheSceneGivesIt) {
+  if (!fsi::bullet_available()) GTEST_SKIP() << "built without Bullet";
+  const std::string yaml =
+      replace(kFall, "MOTION", "bullet, contact: {youngs_modulus: 1.0e8, restitution: 0.5, friction: 0.3}");
+  try {
+    fsi::Simulation sim(tools::read_scene_string(yaml, "test.yaml"), cpu());
+    FAIL() << "a bullet body with a contact material was accepted";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("test.yaml:12:91:"), std::string::npos) << what;
+    EXPECT_NE(what.find("'contact' (DEM contacts) applies to 'motion: free'"), std::string::npos) << what;
+  }
+}
