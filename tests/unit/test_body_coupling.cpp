@@ -32,21 +32,6 @@ using test::replace;
 
 
 
-const char* kPush = R"(
-name: push
-dimensions: 2
-resolution: {particle_spacing: 0.02, smoothing_ratio: 2.0}
-time: {end: 1.0, cfl: 0.2}
-gravity: [0, 0]
-numerics: {boundary: {type: BOUNDARY}}
-materials:
-  water: {density: 1000, sound_speed: 20}
-fluids:
-  - {material: water, box: {min: [0, 0], max: [0.3, 0.3]}, initial_velocity: {direction: +x, mean: 1.0}}
-structures:
-  - {name: box, box: {size: [0.1, 0.1]}, position: [0.35, 0.2], rotation: 10, motion: free, density: 800}
-domain: {min: [-1, -1], max: [2, 2]}
-)";
 
 
 struct Momentum {
@@ -57,7 +42,7 @@ struct Momentum {
 class NewtonThirdLaw : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(NewtonThirdLaw, FluidMomentumChangeIsMinusTheBodyImpulse) {
-  fsi::Simulation sim(scene_of(replace(kPush, "BOUNDARY", GetParam())), cpu());
+  fsi::Simulation sim(scene_of(test::push_scene("free", GetParam())), cpu());
   sim.start();
   ASSERT_NE(sim.bodies(), nullptr);
   const auto& store = sim.store();
@@ -113,7 +98,7 @@ TEST_P(NewtonThirdLaw, FluidMomentumChangeIsMinusTheBodyImpulse) {
 INSTANTIATE_TEST_SUITE_P(Boundaries, NewtonThirdLaw, ::testing::Values("dbc", "mdbc"));
 
 TEST(BodyCoupling, ParticlesAreTheRigidImageOfTheBody) {
-  fsi::Simulation sim(scene_of(replace(kPush, "BOUNDARY", "mdbc")), cpu());
+  fsi::Simulation sim(scene_of(test::push_scene("free", "mdbc")), cpu());
   sim.start();
   for (int step = 0; step < 20; ++step) sim.step();
   const fsi::RigidBody& b = sim.bodies()->body(0);
@@ -145,23 +130,9 @@ TEST(BodyCoupling, ParticlesAreTheRigidImageOfTheBody) {
   EXPECT_EQ(count, sim.summary().structure_particles);
 }
 
-const char* kFall = R"(
-name: fall
-dimensions: 2
-resolution: {particle_spacing: 0.02, smoothing_ratio: 2.0}
-time: {end: 1.0, cfl: 0.2}
-gravity: [0, -9.81]
-materials:
-  water: {density: 1000, sound_speed: 20}
-fluids:
-  - {material: water, box: {min: [0, 0], max: [0.1, 0.1]}}
-structures:
-  - {name: block, box: {size: [0.1, 0.1]}, position: [1.0, 1.0], motion: free, density: 500LOCK}
-domain: {min: [-0.5, -3], max: [1.5, 1.5]}
-)";
 
 TEST(BodyCoupling, FreeFallFarFromTheFluidIsExact) {
-  fsi::Simulation sim(scene_of(replace(kFall, "LOCK", "")), cpu());
+  fsi::Simulation sim(scene_of(test::fall_scene("free")), cpu());
   sim.start();
   const fsi::RigidBody& b = sim.bodies()->body(0);
   const Eigen::Vector3d x0 = b.position();
@@ -196,7 +167,7 @@ TEST(BodyCoupling, FreeFallFarFromTheFluidIsExact) {
 }
 
 TEST(BodyCoupling, LockedAxisDoesNotMove) {
-  fsi::Simulation sim(scene_of(replace(kFall, "LOCK", ", lock: [y]")), cpu());
+  fsi::Simulation sim(scene_of(test::fall_scene("free", ", lock: [y]")), cpu());
   sim.start();
   const Eigen::Vector3d x0 = sim.bodies()->body(0).position();
   for (int i = 0; i < 50; ++i) sim.step();
@@ -206,7 +177,7 @@ TEST(BodyCoupling, LockedAxisDoesNotMove) {
 
 TEST(BodyCoupling, MassPropertiesOfASampledBox) {
   // A 0.2 x 0.1 m box of density 500 kg/m^3: 10 kg/m, I_zz = m (a^2 + b^2) / 12.
-  fsi::Simulation sim(scene_of(replace(replace(kFall, "LOCK", ""), "size: [0.1, 0.1]", "size: [0.2, 0.1]")), cpu());
+  fsi::Simulation sim(scene_of(replace(test::fall_scene("free"), "size: [0.1, 0.1]", "size: [0.2, 0.1]")), cpu());
   ASSERT_EQ(sim.summary().free_bodies.size(), 1u);
   const auto& mp = sim.summary().free_bodies[0].mass_properties;
   const double m = 500 * 0.2 * 0.1;
@@ -215,7 +186,7 @@ TEST(BodyCoupling, MassPropertiesOfASampledBox) {
   EXPECT_NEAR(mp.centre_of_mass.x(), 1.0, 1e-12);
   EXPECT_NEAR(mp.centre_of_mass.y(), 1.0, 1e-12);
   // Given mass and centre: the inertia of the uniform shape moved to the given centre.
-  fsi::Simulation given(scene_of(replace(kFall, "density: 500LOCK", "mass: 3, centre_of_mass: [1.0, 0.99]")), cpu());
+  fsi::Simulation given(scene_of(replace(test::fall_scene("free"), "density: 500", "mass: 3, centre_of_mass: [1.0, 0.99]")), cpu());
   const auto& g = given.summary().free_bodies[0].mass_properties;
   EXPECT_EQ(g.mass, 3.0);
   EXPECT_EQ(g.centre_of_mass.y(), 0.99);
@@ -223,7 +194,7 @@ TEST(BodyCoupling, MassPropertiesOfASampledBox) {
 }
 
 TEST(BodyCoupling, FixedStructuresPayNothing) {
-  fsi::Simulation sim(scene_of(replace(kFall, "motion: free, density: 500LOCK", "motion: fixed")), cpu());
+  fsi::Simulation sim(scene_of(replace(test::fall_scene("free"), "motion: free, density: 500", "motion: fixed")), cpu());
   EXPECT_EQ(sim.bodies(), nullptr);
   EXPECT_EQ(sim.fields().body_offset, -1);
   EXPECT_EQ(sim.fields().body_normal, -1);

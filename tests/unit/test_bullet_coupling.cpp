@@ -32,24 +32,10 @@ using test::replace;
 
 
 
-const char* kFall = R"(
-name: fall
-dimensions: 2
-resolution: {particle_spacing: 0.02, smoothing_ratio: 2.0}
-time: {end: 1.0, cfl: 0.2}
-gravity: [0, -9.81]
-materials:
-  water: {density: 1000, sound_speed: 20}
-fluids:
-  - {material: water, box: {min: [0, 0], max: [0.1, 0.1]}}
-structures:
-  - {name: block, box: {size: [0.1, 0.1]}, position: [1.0, 1.0], motion: MOTION, density: 500}
-domain: {min: [-0.5, -3], max: [1.5, 1.5]}
-)";
 
 TEST(BulletCoupling, FreeFallFarFromTheFluidIsExact) {
   if (!fsi::bullet_available()) GTEST_SKIP() << "built without Bullet";
-  fsi::Simulation sim(tools::read_scene_string(replace(kFall, "MOTION", "bullet"), "test.yaml"), cpu());
+  fsi::Simulation sim(tools::read_scene_string(test::fall_scene("bullet"), "test.yaml"), cpu());
   sim.start();
   ASSERT_NE(sim.bodies(), nullptr);
   ASSERT_TRUE(sim.bodies()->is_bullet(0));
@@ -83,26 +69,11 @@ TEST(BulletCoupling, FreeFallFarFromTheFluidIsExact) {
   EXPECT_EQ(body_particles, sim.summary().structure_particles);
 }
 
-const char* kPush = R"(
-name: push
-dimensions: 2
-resolution: {particle_spacing: 0.02, smoothing_ratio: 2.0}
-time: {end: 1.0, cfl: 0.2}
-gravity: [0, 0]
-numerics: {boundary: {type: mdbc}}
-materials:
-  water: {density: 1000, sound_speed: 20}
-fluids:
-  - {material: water, box: {min: [0, 0], max: [0.3, 0.3]}, initial_velocity: {direction: +x, mean: 1.0}}
-structures:
-  - {name: box, box: {size: [0.1, 0.1]}, position: [0.35, 0.2], rotation: 10, motion: MOTION, density: 800}
-domain: {min: [-1, -1], max: [2, 2]}
-)";
 
 TEST(BulletCoupling, PushedBoxFollowsTheFreeBoxPath) {
   if (!fsi::bullet_available()) GTEST_SKIP() << "built without Bullet";
-  fsi::Simulation free_sim(tools::read_scene_string(replace(kPush, "MOTION", "free"), "test.yaml"), cpu());
-  fsi::Simulation bullet_sim(tools::read_scene_string(replace(kPush, "MOTION", "bullet"), "test.yaml"), cpu());
+  fsi::Simulation free_sim(tools::read_scene_string(test::push_scene("free", "mdbc"), "test.yaml"), cpu());
+  fsi::Simulation bullet_sim(tools::read_scene_string(test::push_scene("bullet", "mdbc"), "test.yaml"), cpu());
   free_sim.start();
   bullet_sim.start();
   double dx = 0, dq = 0;
@@ -125,7 +96,7 @@ TEST(BulletCoupling, PushedBoxFollowsTheFreeBoxPath) {
 
 TEST(BulletCoupling, CheckPrintsTheBulletBodyAndBadLocksAreLocated) {
   if (!fsi::bullet_available()) GTEST_SKIP() << "built without Bullet";
-  const std::string text = tools::describe_scene(tools::read_scene_string(replace(kFall, "MOTION", "bullet"), "t.yaml"));
+  const std::string text = tools::describe_scene(tools::read_scene_string(test::fall_scene("bullet"), "t.yaml"));
   EXPECT_NE(text.find("bullet body block: mass 5 kg/m"), std::string::npos) << text;
   const char* k3d = R"(
 name: lock
@@ -185,7 +156,7 @@ domain: {min: [-0.5, -0.5, -1], max: [1.5, 1.5, 1.5]}
 TEST(BulletCoupling, WithoutBulletTheSceneIsRefusedAtTheMotion) {
   if (fsi::bullet_available()) GTEST_SKIP() << "built with Bullet";
   try {
-    tools::read_scene_string(replace(kFall, "MOTION", "bullet"), "t.yaml");
+    tools::read_scene_string(test::fall_scene("bullet"), "t.yaml");
     FAIL() << "no error";
   } catch (const std::exception& e) {
     const std::string m = e.what();
@@ -202,7 +173,7 @@ TEST(BulletCoupling, WithoutBulletTheSceneIsRefusedAtTheMotion) {
 TEST(BulletCoupling, ContactMaterialOnABulletBodyIsRefusedWhereTheSceneGivesIt) {
   if (!fsi::bullet_available()) GTEST_SKIP() << "built without Bullet";
   const std::string yaml =
-      replace(kFall, "MOTION", "bullet, contact: {youngs_modulus: 1.0e8, restitution: 0.5, friction: 0.3}");
+      test::fall_scene("bullet, contact: {youngs_modulus: 1.0e8, restitution: 0.5, friction: 0.3}");
   try {
     fsi::Simulation sim(tools::read_scene_string(yaml, "test.yaml"), cpu());
     FAIL() << "a bullet body with a contact material was accepted";
