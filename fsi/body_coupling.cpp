@@ -88,7 +88,10 @@ void BodyCoupling::after_kick(sph::Backend& backend, double half_dt) {
       // and contact impulses included, through the continuity pass. Its positions wait for the drift.
       bullet_->step(2 * half_dt);
       for (std::size_t k = 0; k < bodies_.size(); ++k)
-        if (is_bullet(k)) bullet_->write_mirror_velocity(k, *bodies_[k]);
+        if (is_bullet(k)) {
+          bullet_->write_mirror_velocity(k, *bodies_[k]);
+          contact_mean_[k] = bullet_->contact_load(k);
+        }
     }
   }
   drifted_ = false;
@@ -145,6 +148,7 @@ void BodyCoupling::after_drift(sph::Backend& backend, double dt) {
     }
   }
   for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    if (is_bullet(k)) continue;  // Bullet's, from its step
     contact_mean_[k].force = impulse[k].force / dt;
     contact_mean_[k].torque = impulse[k].torque / dt;
   }

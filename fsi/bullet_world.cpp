@@ -9,6 +9,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "fsi/scene_interactions.hpp"
 #include "fsi/spring_damper.hpp"
 #include "geometry/placement.hpp"
 
@@ -92,7 +93,8 @@ BulletShape bullet_shape(const StructureSpec& st, int dims, const geometry::Tria
 }
 
 std::unique_ptr<BulletWorld> make_bullet_world(const Scene& scene, const std::vector<std::optional<MassProperties>>& mass,
-                                               const std::vector<geometry::TriangleMesh>& meshes) {
+                                               const std::vector<geometry::TriangleMesh>& meshes,
+                                               const std::vector<std::vector<Eigen::Vector3d>>& surface) {
   const int d = scene.dimensions;
   std::vector<BulletBodySpec> specs;
   std::vector<bool> other_moving(scene.structures.size(), false);
@@ -113,6 +115,9 @@ std::unique_ptr<BulletWorld> make_bullet_world(const Scene& scene, const std::ve
       spec.mask.translation[a] = !st.lock_translation[a];
       spec.mask.rotation[a] = !st.lock_rotation[a];
     }
+    if (st.contact.given)
+      spec.contact = ContactMaterial{st.contact.youngs_modulus, st.contact.poisson_ratio, st.contact.restitution,
+                                     st.contact.friction};
     try {
       spec.shape = bullet_shape(st, d, k < meshes.size() ? &meshes[k] : nullptr);
       // Each body alone first, so that an error names its structure.
@@ -124,7 +129,15 @@ std::unique_ptr<BulletWorld> make_bullet_world(const Scene& scene, const std::ve
   }
   if (!first) return nullptr;
   const Eigen::Vector3d g(scene.gravity[0], scene.gravity[1], d == 3 ? scene.gravity[2] : 0.0);
-  return std::make_unique<BulletWorld>(d, g, specs, scene.constraints, false, other_moving);
+  // The obstacles of the bodies that touch (the DEM contacts' description, scene_interactions.hpp).
+  std::optional<ContactWorld> obstacles;
+  if (std::any_of(specs.begin(), specs.end(), [](const BulletBodySpec& b) { return b.contact.has_value(); })) {
+    SurfaceLayers layers = surface;
+    layers.resize(scene.structures.size());
+    obstacles = contact_world(scene, layers);
+  }
+  return std::make_unique<BulletWorld>(d, g, specs, scene.constraints, false, other_moving,
+                                       obstacles ? &*obstacles : nullptr);
 }
 
 #ifdef TURBID_HAVE_BULLET
@@ -144,7 +157,27 @@ btMatrix3x3 to_bt_matrix(const Eigen::Matrix3d& m) {
 }
 
 constexpr double kHalfDepth2d = 0.5;  // 2D shapes span one metre of depth
+constexpr double kObstacleHalfDepth2d = 1.0;  // 2D obstacles reach beyond the bodies' depth
 constexpr double kBulletMargin = 0.04;
+constexpr double kTouchDistance = 1e-9;  // [m] see the constructor
+// Friction of an obstacle without a material: above any body's, so that the pair takes the body's.
+constexpr double kRigidFriction = 1e30;
+
+// Collision groups: bodies with a contact material touch each other and the obstacles; bodies
+// without one touch nothing.
+constexpr int kContactGroup = 1 << 6;
+constexpr int kObstacleGroup = 1 << 7;
+constexpr int kSilentGroup = 1 << 8;
+
+// A pair's restitution and friction: the smaller of its two sides' (the DEM rule, body_contacts.hpp).
+btScalar smaller_restitution(const btCollisionObject* a, const btCollisionObject* b) {
+  return std::min(a->getRestitution(), b->getRestitution());
+}
+btScalar smaller_friction(const btCollisionObject* a, const btCollisionObject* b) {
+  return std::min(a->getFriction(), b->getFriction());
+}
+
+double margin_for(double smallest_extent) { return std::min(kBulletMargin, 0.1 * smallest_extent); }
 
 struct Body {
   std::size_t structure = 0;
@@ -158,6 +191,7 @@ struct Body {
   std::unique_ptr<btRigidBody> rigid;
   Eigen::Vector3d impulse = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_impulse = Eigen::Vector3d::Zero();
+  Wrench contact;  // of the last step
 };
 
 // A spring end: a body (its point relative to the centre, turbid's body frame) or a world anchor.
@@ -193,12 +227,16 @@ struct BulletWorld::Impl {
   std::vector<int> by_structure;
   std::vector<Spring> springs;
   std::vector<std::unique_ptr<btTypedConstraint>> hinges;
+  std::vector<std::unique_ptr<btCollisionShape>> obstacle_shapes;  // children first, then their compounds
+  std::vector<std::unique_ptr<btRigidBody>> obstacles;
+  double max_penetration = 0;
 
   ~Impl() {
     if (!world) return;
     for (auto& h : hinges) world->removeConstraint(h.get());
     for (auto& b : bodies)
       if (b->rigid) world->removeRigidBody(b->rigid.get());
+    for (auto& o : obstacles) world->removeRigidBody(o.get());
   }
 
   const Body& body_of(std::size_t structure) const {
@@ -223,7 +261,98 @@ struct BulletWorld::Impl {
   void add_body(const BulletBodySpec& spec);
   void add_constraint(const ConstraintSpec& c, const std::vector<bool>& other_moving);
   void spring_impulses(double duration);
+  void add_obstacles(const ContactWorld& w);
+  void add_obstacle(std::unique_ptr<btCollisionShape> shape, const btTransform& where,
+                    const std::optional<ContactMaterial>& material);
+  void collect_contacts(double dt);
 };
+
+void BulletWorld::Impl::add_obstacle(std::unique_ptr<btCollisionShape> shape, const btTransform& where,
+                                     const std::optional<ContactMaterial>& material) {
+  btRigidBody::btRigidBodyConstructionInfo info(0.0, nullptr, shape.get(), btVector3(0, 0, 0));
+  info.m_startWorldTransform = where;
+  auto r = std::make_unique<btRigidBody>(info);  // mass 0: static
+  r->setRestitution(material ? material->restitution : 1.0);
+  r->setFriction(material ? material->friction : kRigidFriction);
+  world->addRigidBody(r.get(), kObstacleGroup, kContactGroup);
+  obstacle_shapes.push_back(std::move(shape));
+  obstacles.push_back(std::move(r));
+}
+
+void BulletWorld::Impl::add_obstacles(const ContactWorld& w) {
+  for (const ContactFace& f : w.faces) {
+    // A slab behind the face, as thick as the face is long.
+    const double l1 = f.edge_1.norm(), l2 = f.edge_2.norm();
+    if (!(l1 > 0)) continue;
+    const Eigen::Vector3d u1 = f.edge_1 / l1;
+    Eigen::Vector3d u2 = dims == 2 || !(l2 > 0) ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d(f.edge_2 / l2);
+    Eigen::Matrix3d axes;
+    axes << u1, u2, f.normal;
+    if (axes.determinant() < 0) axes.col(1) = -axes.col(1);
+    const double half_thick = 0.5 * std::max(l1, l2);
+    const Eigen::Vector3d half(0.5 * l1, dims == 2 ? kObstacleHalfDepth2d : 0.5 * l2, half_thick);
+    const Eigen::Vector3d centre = f.origin + 0.5 * f.edge_1 + (dims == 2 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(0.5 * f.edge_2)) -
+                                   half_thick * f.normal;
+    auto box = std::make_unique<btBoxShape>(to_bt(half));
+    box->setMargin(margin_for(2 * std::min(half.x(), half.y())));
+    add_obstacle(std::move(box), btTransform(to_bt_matrix(axes), to_bt(centre)), std::nullopt);
+  }
+  for (const ContactBox& b : w.boxes) {
+    Eigen::Vector3d half = 0.5 * (b.max - b.min);
+    Eigen::Vector3d centre = 0.5 * (b.max + b.min);
+    if (dims == 2) {
+      half.z() = kObstacleHalfDepth2d;
+      centre.z() = 0;
+    }
+    auto box = std::make_unique<btBoxShape>(to_bt(half));
+    box->setMargin(margin_for(2 * (dims == 2 ? std::min(half.x(), half.y()) : half.minCoeff())));
+    add_obstacle(std::move(box), btTransform(btMatrix3x3::getIdentity(), to_bt(centre)), std::nullopt);
+  }
+  for (const FixedContactShape& f : w.fixed) {
+    if (f.centres.empty() || !(f.radius > 0)) continue;
+    // One shared sphere (2D: a cylinder along z) at every centre.
+    std::unique_ptr<btCollisionShape> child;
+    if (dims == 2) {
+      child = std::make_unique<btCylinderShapeZ>(btVector3(f.radius, f.radius, kObstacleHalfDepth2d));
+      child->setMargin(margin_for(2 * f.radius));
+    } else {
+      child = std::make_unique<btSphereShape>(f.radius);
+    }
+    auto compound = std::make_unique<btCompoundShape>(true, int(f.centres.size()));
+    for (const auto& c : f.centres)
+      compound->addChildShape(btTransform(btMatrix3x3::getIdentity(), to_bt(Eigen::Vector3d(c.x(), c.y(), dims == 2 ? 0.0 : c.z()))),
+                              child.get());
+    obstacle_shapes.push_back(std::move(child));
+    add_obstacle(std::move(compound), btTransform::getIdentity(), f.material);
+  }
+}
+
+void BulletWorld::Impl::collect_contacts(double dt) {
+  for (auto& b : bodies) b->contact = Wrench{};
+  max_penetration = 0;
+  btDispatcher& d = *world->getDispatcher();
+  auto add = [&](int index, const btVector3& at, const Eigen::Vector3d& J) {
+    if (index < 0) return;
+    Body& b = *bodies[std::size_t(index)];
+    const Eigen::Vector3d r = from_bt(at) - from_bt(b.rigid->getCenterOfMassPosition());
+    b.contact.force += J / dt;
+    b.contact.torque += r.cross(J) / dt;
+  };
+  for (int m = 0; m < d.getNumManifolds(); ++m) {
+    const btPersistentManifold& pm = *d.getManifoldByIndexInternal(m);
+    const int ia = pm.getBody0()->getUserIndex(), ib = pm.getBody1()->getUserIndex();
+    for (int c = 0; c < pm.getNumContacts(); ++c) {
+      const btManifoldPoint& pt = pm.getContactPoint(c);
+      max_penetration = std::max(max_penetration, double(-pt.getDistance()));
+      // The impulses the solver applied to body 0 (its normal points from body 1 to body 0).
+      const Eigen::Vector3d J = from_bt(pt.m_normalWorldOnB * pt.getAppliedImpulse() +
+                                        pt.m_lateralFrictionDir1 * pt.m_appliedImpulseLateral1 +
+                                        pt.m_lateralFrictionDir2 * pt.m_appliedImpulseLateral2);
+      add(ia, pt.getPositionWorldOnA(), J);
+      add(ib, pt.getPositionWorldOnB(), -J);
+    }
+  }
+}
 
 void BulletWorld::Impl::add_body(const BulletBodySpec& spec) {
   auto b = std::make_unique<Body>();
@@ -344,7 +473,15 @@ void BulletWorld::Impl::add_body(const BulletBodySpec& spec) {
   if (!weight_by_bullet) flags |= int(BT_DISABLE_WORLD_GRAVITY);
   r.setFlags(flags);
   if (!weight_by_bullet) r.setGravity(btVector3(0, 0, 0));
-  world->addRigidBody(&r);  // takes the world's gravity unless BT_DISABLE_WORLD_GRAVITY
+  r.setUserIndex(int(bodies.size()));  // contacts find their body by it
+  if (spec.contact) {
+    r.setRestitution(spec.contact->restitution);
+    r.setFriction(spec.contact->friction);
+    world->addRigidBody(&r, kContactGroup, kContactGroup | kObstacleGroup);
+  } else {
+    world->addRigidBody(&r, kSilentGroup, 0);
+  }
+  // (Each takes the world's gravity unless BT_DISABLE_WORLD_GRAVITY.)
 
   if (spec.structure >= by_structure.size()) by_structure.resize(spec.structure + 1, -1);
   if (by_structure[spec.structure] >= 0)
@@ -437,7 +574,7 @@ void BulletWorld::Impl::spring_impulses(double duration) {
 
 BulletWorld::BulletWorld(int dims, const Eigen::Vector3d& gravity, const std::vector<BulletBodySpec>& bodies,
                          const std::vector<ConstraintSpec>& constraints, bool weight_by_bullet,
-                         const std::vector<bool>& other_moving)
+                         const std::vector<bool>& other_moving, const ContactWorld* obstacles)
     : impl_(std::make_unique<Impl>()) {
   if (dims != 2 && dims != 3) throw std::invalid_argument("a bullet world is 2D or 3D");
   Impl& w = *impl_;
@@ -452,7 +589,23 @@ BulletWorld::BulletWorld(int dims, const Eigen::Vector3d& gravity, const std::ve
   w.world = std::make_unique<btDiscreteDynamicsWorld>(w.dispatcher.get(), w.broadphase.get(), w.solver.get(),
                                                       w.config.get());
   w.world->setGravity(to_bt(w.gravity));
+  // Penetration is always corrected by split impulses (positions only): Bullet's default folds a
+  // shallow penetration (above -0.04 m) into the contact velocity, which adds energy to a bounce.
+  btContactSolverInfo& info = w.world->getSolverInfo();
+  info.m_splitImpulse = 1;
+  info.m_splitImpulsePenetrationThreshold = std::numeric_limits<btScalar>::infinity();
+  // Contacts only where objects touch or overlap: Bullet's default also keeps speculative contacts
+  // up to 2% of a shape's size apart and lets a body close such a gap in one step, taking gap / dt
+  // off its rebound speed (a bounce's restitution then depends on where in a step the touch falls).
+  // An absolute threshold of kTouchDistance instead; the overlap a step leaves (at most the approach
+  // speed x dt) is removed by the split impulses.
+  w.dispatcher->setDispatcherFlags(w.dispatcher->getDispatcherFlags() &
+                                   ~int(btCollisionDispatcher::CD_USE_RELATIVE_CONTACT_BREAKING_THRESHOLD));
+  gContactBreakingThreshold = kTouchDistance;
+  gCalculateCombinedRestitutionCallback = &smaller_restitution;
+  gCalculateCombinedFrictionCallback = &smaller_friction;
   for (const auto& b : bodies) w.add_body(b);
+  if (obstacles) w.add_obstacles(*obstacles);
   for (const auto& c : constraints) w.add_constraint(c, other_moving);
 }
 
@@ -485,7 +638,12 @@ void BulletWorld::step(double dt) {
   // maxSubSteps = 0: exactly one internal step of length dt (see the header); Bullet clears the
   // applied forces at its end.
   impl_->world->stepSimulation(btScalar(dt), 0);
+  impl_->collect_contacts(dt);
 }
+
+Wrench BulletWorld::contact_load(std::size_t structure) const { return impl_->body_of(structure).contact; }
+double BulletWorld::last_max_penetration() const { return impl_->max_penetration; }
+std::size_t BulletWorld::obstacle_count() const { return impl_->obstacles.size(); }
 
 BulletBodyState BulletWorld::state(std::size_t structure) const { return impl_->state(impl_->body_of(structure)); }
 
@@ -541,9 +699,12 @@ bool bullet_available() { return false; }
 struct BulletWorld::Impl {};
 
 BulletWorld::BulletWorld(int, const Eigen::Vector3d&, const std::vector<BulletBodySpec>&,
-                         const std::vector<ConstraintSpec>&, bool, const std::vector<bool>&) {
+                         const std::vector<ConstraintSpec>&, bool, const std::vector<bool>&, const ContactWorld*) {
   throw std::runtime_error(kNoBulletMessage);
 }
+Wrench BulletWorld::contact_load(std::size_t) const { throw std::runtime_error(kNoBulletMessage); }
+double BulletWorld::last_max_penetration() const { return 0; }
+std::size_t BulletWorld::obstacle_count() const { return 0; }
 BulletWorld::~BulletWorld() = default;
 std::size_t BulletWorld::body_count() const { return 0; }
 int BulletWorld::body_of(std::size_t) const { return -1; }

@@ -21,8 +21,22 @@
 // primitive's z), meshes a convex hull of the surface points (btConvexHullShape). 2D shapes are the
 // 3D ones extruded over one metre of depth, z in [-0.5, 0.5] m (2D masses are per metre of depth):
 // a box's third half extent 0.5 m, a circle a cylinder along z. The collision margin is Bullet's
-// 0.04 m or a tenth of the body's smallest extent if smaller. Only bullet bodies are in the world:
-// they collide with each other through Bullet's contacts, not with the walls or other structures.
+// 0.04 m or a tenth of the body's smallest extent if smaller.
+//
+// Contacts are Bullet's (collision detection, impulse-based contact with restitution and Coulomb
+// friction, solved with the step). A body takes part in contacts when its structure has a contact
+// material (`contact:`), as a free body does: it then touches the other bullet bodies with one and
+// the scene's obstacles, the same ContactWorld the DEM contacts use (scene_interactions.hpp): a
+// container face or polyline segment as a slab behind the face (a box as thick as the face is long,
+// so nothing tunnels through it), a solid box as its box, a fixed structure as the spheres of its
+// surface layer (dx/2, as in the DEM contacts; its exact sphere for a sphere or 2D cylinder). In 2D
+// every obstacle spans z in [-1, 1] m. Bullet's contacts are rigid: a material's restitution and
+// friction are used, its Young's modulus and Poisson ratio are not (they set the DEM contacts'
+// stiffness). A pair takes the smaller restitution and the smaller friction of its two sides (the
+// DEM rule; an obstacle without a material takes the body's); Bullet gives no restitution below an
+// approach speed of 0.2 m/s (its m_restitutionVelocityThreshold). Bullet bodies do not touch free
+// (built-in) bodies or prescribed structures. The contact force on a body (its impulses over the
+// step / dt) goes to forces.csv as a free body's does.
 //
 // Locks: Bullet's linear and angular factors (world axes), 2D adds z translation and x, y rotation
 // locked, as for free bodies. A linear factor 0 is exact (force and constraint impulses are
@@ -75,6 +89,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "fsi/body_contacts.hpp"
 #include "fsi/mass_properties.hpp"
 #include "fsi/rigid_body.hpp"
 #include "fsi/scene.hpp"
@@ -105,6 +120,7 @@ struct BulletBodySpec {
   MassProperties mass_properties;   // turbid's, about the centre of mass, world axes at t = 0
   DofMask mask;                     // free degrees of freedom, world axes (2D: planar locks added)
   BulletShape shape;
+  std::optional<ContactMaterial> contact;  // none: the body touches nothing
 };
 
 // A body's state in turbid's conventions: centre of mass, orientation body frame -> world (the body
@@ -125,9 +141,10 @@ class BulletWorld {
   // constraint tying one to a bullet body is refused. Missing entries: fixed.
   // Throws std::invalid_argument (a bad mass, inertia, lock or constraint) or std::runtime_error
   // (kNoBulletMessage) when built without Bullet.
+  // obstacles: what bodies with a contact material touch besides each other (nullptr: nothing).
   BulletWorld(int dims, const Eigen::Vector3d& gravity, const std::vector<BulletBodySpec>& bodies,
               const std::vector<ConstraintSpec>& constraints, bool weight_by_bullet,
-              const std::vector<bool>& other_moving = {});
+              const std::vector<bool>& other_moving = {}, const ContactWorld* obstacles = nullptr);
   ~BulletWorld();
   BulletWorld(const BulletWorld&) = delete;
   BulletWorld& operator=(const BulletWorld&) = delete;
@@ -146,6 +163,13 @@ class BulletWorld {
   void kick(double duration, const std::vector<Wrench>& loads);
   // One Bullet step of dt with force = impulse / dt, torque = angular impulse / dt; clears the impulses.
   void step(double dt);
+
+  // The contact wrench on a body in the last step (its contact and friction impulses / dt, about
+  // the centre of mass, world frame) [N], [N m], and the deepest penetration Bullet left between
+  // any two touching objects at the end of that step [m] (0 when none).
+  Wrench contact_load(std::size_t structure) const;
+  double last_max_penetration() const;
+  std::size_t obstacle_count() const;
 
   BulletBodyState state(std::size_t structure) const;
   // Puts a body in this state (velocities projected on its free axes) and clears its impulse.
@@ -181,9 +205,11 @@ BulletShape bullet_shape(const StructureSpec& st, int dims, const geometry::Tria
 
 // The coupled world of a scene's bullet structures (weight through the kicks): mass[k] the mass
 // properties of structure k as the run uses them (given for every bullet structure), meshes[k] its
-// mesh (mesh shapes; may be empty otherwise). Errors name the structure's or constraint's
+// mesh (mesh shapes; may be empty otherwise), surface[k] the surface layer of structure k (fixed
+// structures as obstacles; scene_interactions.hpp). Errors name the structure's or constraint's
 // file:line:column (std::invalid_argument), or say kNoBulletMessage there when built without Bullet.
 std::unique_ptr<BulletWorld> make_bullet_world(const Scene& scene, const std::vector<std::optional<MassProperties>>& mass,
-                                               const std::vector<geometry::TriangleMesh>& meshes);
+                                               const std::vector<geometry::TriangleMesh>& meshes,
+                                               const std::vector<std::vector<Eigen::Vector3d>>& surface = {});
 
 }  // namespace turbid::fsi

@@ -105,7 +105,8 @@ struct WallSpec {
 
 // DEM contact material of a moving structure (fsi/contact.hpp): Hertz normal force with a damping
 // that gives `restitution`, Coulomb friction `friction` through a tangential spring. A structure
-// without it (given = false) takes part in no contact.
+// without it (given = false) takes part in no contact. A bullet body's contacts are Bullet's rigid
+// ones (fsi/bullet_world.hpp): restitution and friction only, youngs_modulus optional (0: not given).
 struct ContactMaterialSpec {
   bool given = false;
   double youngs_modulus = 0;  // E [Pa]

@@ -126,10 +126,8 @@ std::unique_ptr<BodyContacts> body_contacts(const Scene& scene, const SurfaceLay
   bool any = false;
   for (std::size_t k = 0; k < scene.structures.size(); ++k) {
     const StructureSpec& st = scene.structures[k];
-    if (!bodies[k] || !st.contact.given) continue;
-    if (st.motion == StructureSpec::Motion::bullet)
-      located(st.contact.where, "structure '" + st.name + "': 'contact' (DEM contacts) applies to 'motion: free'; "
-                                "bullet bodies collide with each other through Bullet's own collision detection");
+    // A bullet body's contacts are Bullet's (bullet_world.hpp).
+    if (!bodies[k] || !st.contact.given || st.motion == StructureSpec::Motion::bullet) continue;
     const RigidBody& b = *bodies[k];
     BodyContactShape& s = shapes[k];
     s.active = true;

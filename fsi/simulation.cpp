@@ -517,7 +517,8 @@ bool has_bullet_structures(const Scene& scene) {
 
 // The Bullet world of the scene's bullet structures (fsi/bullet_world.hpp), with the mass properties
 // the run uses; their meshes are read again here (the sampling's copy is gone).
-static std::unique_ptr<BulletWorld> bullet_world(const Scene& scene, const std::vector<FreeBodySummary>& free_bodies) {
+static std::unique_ptr<BulletWorld> bullet_world(const Scene& scene, const std::vector<FreeBodySummary>& free_bodies,
+                                                 const SurfaceLayers& surface) {
   std::vector<std::optional<MassProperties>> mass(scene.structures.size());
   for (const auto& fb : free_bodies) mass[fb.structure] = fb.mass_properties;
   std::vector<geometry::TriangleMesh> meshes(scene.structures.size());
@@ -526,7 +527,7 @@ static std::unique_ptr<BulletWorld> bullet_world(const Scene& scene, const std::
     if (st.motion == StructureSpec::Motion::bullet && st.shape == StructureSpec::Shape::mesh)
       meshes[k] = geometry::load_mesh(st.resolved_file);
   }
-  return make_bullet_world(scene, mass, meshes);
+  return make_bullet_world(scene, mass, meshes, surface);
 }
 
 MassProperties structure_mass_properties(const Scene& scene, const StructureSpec& st) {
@@ -597,7 +598,7 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
     std::unique_ptr<BodyContacts> contacts = body_contacts(scene_, surface_layers_, rigid);
     bodies_ = std::make_unique<BodyCoupling>(std::move(rigid), g);
     bodies_->set_fast_forces(std::move(constraints), std::move(contacts));
-    if (has_bullet_structures(scene_)) bodies_->set_bullet(bullet_world(scene_, summary_.free_bodies));
+    if (has_bullet_structures(scene_)) bodies_->set_bullet(bullet_world(scene_, summary_.free_bodies, surface_layers_));
     solver_->set_coupling(bodies_.get());
     // The particles were written at their sampled positions; the placement rounds x_c + R r0 once,
     // as every later step does, so the first step starts from the same kind of positions.

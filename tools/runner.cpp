@@ -375,6 +375,26 @@ std::string describe_scene(const fsi::Scene& scene) {
       if (st.lock_rotation[std::size_t(a)]) locks += std::string(locks.empty() ? "" : ", ") + "r" + "xyz"[a];
     if (!locks.empty()) os << ", locked " << locks;
     os << "\n";
+    const auto& c = st.contact;
+    if (!c.given) {
+      os << "    contacts: none (no 'contact' material)\n";
+    } else if (st.motion == fsi::StructureSpec::Motion::bullet) {
+      os << "    contacts: Bullet's rigid contacts, restitution " << c.restitution << ", friction " << c.friction
+         << " (walls, fixed structures, other bullet bodies)\n";
+    } else {
+      os << "    contacts: DEM Hertz, E " << c.youngs_modulus << " Pa, Poisson " << c.poisson_ratio << ", restitution "
+         << c.restitution << ", friction " << c.friction << " (walls, fixed structures, other free bodies)\n";
+    }
+  }
+  {
+    bool free_touch = false, bullet_touch = false;
+    for (const auto& st : scene.structures) {
+      if (!st.contact.given) continue;
+      free_touch = free_touch || st.motion == fsi::StructureSpec::Motion::free;
+      bullet_touch = bullet_touch || st.motion == fsi::StructureSpec::Motion::bullet;
+    }
+    if (free_touch && bullet_touch)
+      os << "  note: free and bullet bodies do not touch each other (each kind only its own kind and the obstacles)\n";
   }
   for (const auto& ob : scene.open_boundaries)
     os << "  " << (ob.inlet ? "inlet " : "outlet ") << ob.name << ": flow along "

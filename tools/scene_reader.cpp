@@ -379,7 +379,7 @@ class Reader {
   void read_fluids(const Value& v, fsi::Scene& scene, const std::vector<YAML::Mark>& wall_marks) const;
   void read_structures(const Value& v, fsi::Scene& scene) const;
   void read_motion(const MapView& m, int dims, fsi::StructureSpec& st) const;
-  void read_contact(const Value& v, fsi::ContactMaterialSpec& c) const;
+  void read_contact(const Value& v, fsi::ContactMaterialSpec& c, bool rigid_contacts = false) const;
   void read_constraints(const Value& v, fsi::Scene& scene) const;
   fsi::ConstraintEndSpec read_constraint_end(const Value& v, const fsi::Scene& scene) const;
   void read_path(const MapView& m, const fsi::Scene& scene, fsi::StructureSpec& st) const;
@@ -963,7 +963,7 @@ void Reader::read_structures(const Value& v, fsi::Scene& scene) const {
     st.reference_point = st.position;
     if (auto x = m.get("reference_point")) st.reference_point = point(*x, dims, "m");
     read_motion(m, dims, st);
-    if (auto cv = m.get("contact")) read_contact(*cv, st.contact);
+    if (auto cv = m.get("contact")) read_contact(*cv, st.contact, st.motion == fsi::StructureSpec::Motion::bullet);
     read_path(m, scene, st);
     if (auto cv = m.get("coefficients")) {
       MapView c(*this, *cv, {"flow_direction", "lift_direction", "velocity", "density", "length", "area"}, false);
@@ -1090,12 +1090,17 @@ void Reader::read_motion(const MapView& m, int dims, fsi::StructureSpec& st) con
 
 // contact: {youngs_modulus, poisson_ratio, restitution, friction}: the DEM contact material of a
 // structure (fsi/body_contacts.hpp). On a moving structure it turns its contacts on; on a fixed one
-// it is the obstacle's material (without it a fixed structure is rigid).
-void Reader::read_contact(const Value& v, fsi::ContactMaterialSpec& c) const {
+// it is the obstacle's material (without it a fixed structure is rigid). Bullet's contacts are rigid
+// (fsi/bullet_world.hpp): a bullet body's Young's modulus is optional and unused.
+void Reader::read_contact(const Value& v, fsi::ContactMaterialSpec& c, bool rigid_contacts) const {
   MapView m(*this, v, {"youngs_modulus", "poisson_ratio", "restitution", "friction"});
   c.given = true;
   c.where = where(v.mark);
-  c.youngs_modulus = number(m.need("youngs_modulus"), positive(), "Pa");
+  if (rigid_contacts) {
+    if (auto x = m.get("youngs_modulus")) c.youngs_modulus = number(*x, positive(), "Pa");
+  } else {
+    c.youngs_modulus = number(m.need("youngs_modulus"), positive(), "Pa");
+  }
   if (auto x = m.get("poisson_ratio"))
     c.poisson_ratio = number(*x, {"a number in [0, 0.5]", [](double p) { return p >= 0 && p <= 0.5; }});
   c.restitution = number(m.need("restitution"), open_closed(0.0, 1.0));

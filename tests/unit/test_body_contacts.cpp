@@ -16,6 +16,8 @@
 //    T = 2 pi sqrt(I_pivot / (m g d)) (1 + theta0^2/16) within 0.5%, its pivot opening below 1% of dx;
 //  - the disc dropped on a solid_box wall (exact face) and on a fixed box structure (its surface
 //    particles as dx/2 spheres) rebounds with e within 5% as well; a 3D sphere on a tank floor too;
+//  - the contact tests (Contacts.*) run for 'motion: free' (DEM) and 'motion: bullet' (Bullet's
+//    rigid contacts) with the same scenes, references and tolerances;
 //  - hard case: two boxes thrown by a tilted gravity into each other and a corner of the tank never
 //    interpenetrate by more than 0.1 dx, measured on the particles (dx minus the smallest distance
 //    between surface particles of the two bodies; dx/2 minus a surface particle's distance to a wall).
@@ -31,6 +33,7 @@
 #include <vector>
 
 #include "tests/unit/body_test_support.hpp"
+#include "fsi/bullet_world.hpp"
 #include "fsi/forces.hpp"
 #include "fsi/simulation.hpp"
 #include "tools/scene_reader.hpp"
@@ -61,6 +64,23 @@ const char* kFarTank = "  - box: {min: [3.0, 0], max: [3.1, 0.05]}\n";
 
 // Linear interpolation of the time where v crosses zero between two samples.
 double crossing(double t0, double v0, double t1, double v1) { return t0 + (t1 - t0) * v0 / (v0 - v1); }
+
+// The contact checks run for both integrators: 'motion: free' (the DEM contacts, body_contacts.hpp)
+// and 'motion: bullet' (Bullet's rigid contacts, bullet_world.hpp), with the same scene, reference
+// and tolerance; the bullet runs are skipped in a build without Bullet.
+class Contacts : public ::testing::TestWithParam<std::string> {
+ protected:
+  void SetUp() override {
+    if (GetParam() == "bullet" && !fsi::bullet_available()) GTEST_SKIP() << "built without Bullet";
+  }
+  // The scene text with every 'motion: free' given this test's motion.
+  std::string moved(std::string yaml) const {
+    for (std::size_t at = yaml.find("motion: free"); at != std::string::npos; at = yaml.find("motion: free", at + 1))
+      yaml.replace(at, 12, "motion: " + GetParam());
+    return yaml;
+  }
+  const char* name() const { return GetParam().c_str(); }
+};
 
 TEST(BodyConstraints, SpringMassOscillatesAtSqrtKOverM) {
   const double k = 500, m = 500 * 0.1 * 0.1;  // N/m per m, kg/m (the sampled box's mass is exact)
@@ -128,14 +148,14 @@ constraints:
   EXPECT_LE(worst_l, 1e-12 * scale);
 }
 
-TEST(BodyContacts, DiscDroppedOnTheFloorReboundsWithTheRestitution) {
+TEST_P(Contacts, DiscDroppedOnTheFloorReboundsWithTheRestitution) {
   const double e = 0.5;
   const std::string yaml = head("drop", "[0, -9.81]", 0.3) + "walls:\n  - box: {min: [0, 0], max: [0.6, 0.6]}\n" +
                            kFarTank + R"(structures:
   - {name: ball, sphere: {radius: 0.05}, position: [0.3, 0.25], motion: free, density: 1000,
      contact: {youngs_modulus: 1.0e8, poisson_ratio: 0.3, restitution: 0.5, friction: 0.3}}
 )";
-  fsi::Simulation sim(scene_of(yaml), cpu());
+  fsi::Simulation sim(scene_of(moved(yaml)), cpu());
   sim.start();
   const fsi::RigidBody& b = sim.bodies()->body(0);
   double v_in = 0, v_out = 0;
@@ -158,9 +178,9 @@ TEST(BodyContacts, DiscDroppedOnTheFloorReboundsWithTheRestitution) {
   ASSERT_TRUE(touched);
   ASSERT_GT(v_out, 0) << "the ball should have left the floor by t = 0.3 s";
   const double measured = -v_out / v_in;
-  std::printf("[ measured ] disc on the floor: v_in = %.4f m/s, v_out = %.4f m/s, e = %.4f against %.2f (%+.2f%%), "
+  std::printf("[ measured ] %s disc on the floor: v_in = %.4f m/s, v_out = %.4f m/s, e = %.4f against %.2f (%+.2f%%), "
               "up to %d body substeps per fluid step\n",
-              v_in, v_out, measured, e, 100 * (measured / e - 1), substeps);
+              name(), v_in, v_out, measured, e, 100 * (measured / e - 1), substeps);
   EXPECT_NEAR(measured, e, 0.05 * e);
 }
 
@@ -186,14 +206,14 @@ double bounce(fsi::Simulation& sim, int axis, double end, double* v_in_out = nul
   return 0;
 }
 
-TEST(BodyContacts, DiscReboundsFromASolidBoxAndFromAFixedStructure) {
+TEST_P(Contacts, DiscReboundsFromASolidBoxAndFromAFixedStructure) {
   const double e = 0.5;
   const std::string disc = R"(  - {name: ball, sphere: {radius: 0.05}, position: [0.3, 0.45], motion: free, density: 1000,
      contact: {youngs_modulus: 1.0e8, poisson_ratio: 0.3, restitution: 0.5, friction: 0.3}}
 )";
   // On a solid box (an exact face) ...
-  fsi::Simulation on_box(scene_of(head("drop_box", "[0, -9.81]", 0.4) + "walls:\n  - solid_box: {min: [0.1, 0.1], max: [0.5, 0.2]}\n" +
-                                  kFarTank + "structures:\n" + disc),
+  fsi::Simulation on_box(scene_of(moved(head("drop_box", "[0, -9.81]", 0.4) + "walls:\n  - solid_box: {min: [0.1, 0.1], max: [0.5, 0.2]}\n" +
+                                  kFarTank + "structures:\n" + disc)),
                          cpu());
   on_box.start();
   double v_box = 0;
@@ -201,16 +221,16 @@ TEST(BodyContacts, DiscReboundsFromASolidBoxAndFromAFixedStructure) {
   // ... and on a fixed box structure (its surface particles, spheres of dx/2), whose contact
   // material is rigid-like and more elastic: the pair takes the smaller restitution, the disc's.
   fsi::Simulation on_structure(
-      scene_of(head("drop_post", "[0, -9.81]", 0.4) + "walls:\n" + kFarTank + "structures:\n" + disc +
+      scene_of(moved(head("drop_post", "[0, -9.81]", 0.4) + "walls:\n" + kFarTank + "structures:\n" + disc +
                "  - {name: post, box: {size: [0.4, 0.1]}, position: [0.3, 0.15], contact: {youngs_modulus: 1.0e10, "
-               "restitution: 0.9, friction: 0.5}}\n"),
+               "restitution: 0.9, friction: 0.5}}\n")),
       cpu());
   on_structure.start();
   double v_post = 0;
   const double e_post = bounce(on_structure, 1, 0.4, &v_post);
-  std::printf("[ measured ] disc on a solid box: e = %.4f (v_in %.3f m/s); on a fixed structure: e = %.4f (v_in %.3f m/s); "
-              "against %.2f\n",
-              e_box, v_box, e_post, v_post, e);
+  std::printf("[ measured ] %s disc on a solid box: e = %.4f (v_in %.3f m/s); on a fixed structure: e = %.4f (v_in %.3f "
+              "m/s); against %.2f\n",
+              name(), e_box, v_box, e_post, v_post, e);
   EXPECT_NEAR(e_box, e, 0.05 * e);
   EXPECT_NEAR(e_post, e, 0.05 * e);
   // forces.csv names the contact force with its unit.
@@ -221,23 +241,24 @@ TEST(BodyContacts, DiscReboundsFromASolidBoxAndFromAFixedStructure) {
 
 // A clump's flat face lands on all its bottom spheres at once: they act in parallel and share the
 // mass (body_contacts.hpp), so the box rebounds with the law's restitution too (within 5%).
-TEST(BodyContacts, BoxLandingFlatReboundsWithTheRestitution) {
+TEST_P(Contacts, BoxLandingFlatReboundsWithTheRestitution) {
   const double e = 0.5;
-  fsi::Simulation sim(scene_of(head("flat", "[0, -9.81]", 0.4) + "walls:\n  - box: {min: [0, 0], max: [0.6, 0.6]}\n" +
-                               kFarTank + R"(structures:
+  fsi::Simulation sim(scene_of(moved(head("flat", "[0, -9.81]", 0.4) + "walls:\n  - box: {min: [0, 0], max: [0.6, 0.6]}\n" +
+                                     kFarTank + R"(structures:
   - {name: block, box: {size: [0.2, 0.1]}, position: [0.3, 0.25], motion: free, density: 800,
      contact: {youngs_modulus: 1.0e8, poisson_ratio: 0.3, restitution: 0.5, friction: 0.3}}
-)"),
+)")),
                       cpu());
   sim.start();
   double v_in = 0;
   const double measured = bounce(sim, 1, 0.4, &v_in);
-  std::printf("[ measured ] box landing flat: v_in %.4f m/s, e = %.4f against %.2f (%+.2f%%), face of %d spheres\n", v_in,
-              measured, e, 100 * (measured / e - 1), sim.bodies()->contacts()->shape(0).face_count);
+  const auto* dem = sim.bodies()->contacts();
+  std::printf("[ measured ] %s box landing flat: v_in %.4f m/s, e = %.4f against %.2f (%+.2f%%), face of %d spheres\n",
+              name(), v_in, measured, e, 100 * (measured / e - 1), dem ? dem->shape(0).face_count : 0);
   EXPECT_NEAR(measured, e, 0.05 * e);
 }
 
-TEST(BodyContacts, SphereReboundsFromATankFloorIn3D) {
+TEST_P(Contacts, SphereReboundsFromATankFloorIn3D) {
   const double e = 0.6;
   const std::string yaml = R"(name: drop3d
 dimensions: 3
@@ -256,13 +277,14 @@ structures:
      contact: {youngs_modulus: 1.0e9, poisson_ratio: 0.3, restitution: 0.6, friction: 0.3}}
 domain: {min: [-0.2, -0.2, -0.2], max: [2.3, 0.6, 0.7]}
 )";
-  fsi::Simulation sim(scene_of(yaml), cpu());
+  fsi::Simulation sim(scene_of(moved(yaml)), cpu());
   sim.start();
   double v_in = 0;
   const double measured = bounce(sim, 2, 0.4, &v_in);
   const fsi::RigidBody& b = sim.bodies()->body(0);
-  std::printf("[ measured ] 3D sphere on the floor: v_in %.4f m/s, e = %.4f against %.2f (%+.2f%%); x, y drift %.2e, %.2e m\n",
-              v_in, measured, e, 100 * (measured / e - 1), b.position().x() - 0.2, b.position().y() - 0.2);
+  std::printf("[ measured ] %s 3D sphere on the floor: v_in %.4f m/s, e = %.4f against %.2f (%+.2f%%); x, y drift %.2e, "
+              "%.2e m\n",
+              name(), v_in, measured, e, 100 * (measured / e - 1), b.position().x() - 0.2, b.position().y() - 0.2);
   EXPECT_NEAR(measured, e, 0.05 * e);
 }
 
@@ -308,7 +330,7 @@ constraints:
 struct SlopeRun {
   std::vector<double> t, v, s;
 };
-SlopeRun slide(double degrees, double mu, double end) {
+SlopeRun slide(const std::string& motion, double degrees, double mu, double end) {
   const double th = degrees * std::numbers::pi / 180, c = std::cos(th), s = std::sin(th);
   const double along = 0.7, half = 0.025;
   const double cx = along * c - half * s, cy = along * s + half * c;
@@ -316,10 +338,10 @@ SlopeRun slide(double degrees, double mu, double end) {
   std::snprintf(buf, sizeof buf, R"(walls:
   - polyline: {points: [[0, 0], [%.17g, %.17g]]}
 %sstructures:
-  - {name: block, box: {size: [0.1, 0.05]}, position: [%.17g, %.17g], rotation: %.17g, motion: free, density: 1000,
+  - {name: block, box: {size: [0.1, 0.05]}, position: [%.17g, %.17g], rotation: %.17g, motion: %s, density: 1000,
      contact: {youngs_modulus: 1.0e8, poisson_ratio: 0.3, restitution: 0.5, friction: %.17g}}
 )",
-                c, s, kFarTank, cx, cy, degrees, mu);
+                c, s, kFarTank, cx, cy, degrees, motion.c_str(), mu);
   fsi::Simulation sim(scene_of(head("slope", "[0, -9.81]", end) + buf), cpu());
   sim.start();
   const fsi::RigidBody& b = sim.bodies()->body(0);
@@ -334,11 +356,11 @@ SlopeRun slide(double degrees, double mu, double end) {
   return r;
 }
 
-TEST(BodyContacts, BoxSlidesDownAnInclineWithCoulombFriction) {
+TEST_P(Contacts, BoxSlidesDownAnInclineWithCoulombFriction) {
   const double degrees = 30, mu = 0.3, g = 9.81;
   const double th = degrees * std::numbers::pi / 180;
   const double expected = -g * (std::sin(th) - mu * std::cos(th));
-  const SlopeRun r = slide(degrees, mu, 0.3);
+  const SlopeRun r = slide(GetParam(), degrees, mu, 0.3);
   // Least-squares line v = v0 + a t over t >= 0.05 s (after the first settling).
   double n = 0, st = 0, sv = 0, stt = 0, stv = 0;
   for (std::size_t i = 0; i < r.t.size(); ++i) {
@@ -350,24 +372,24 @@ TEST(BodyContacts, BoxSlidesDownAnInclineWithCoulombFriction) {
     stv += r.t[i] * r.v[i];
   }
   const double a = (n * stv - st * sv) / (n * stt - st * st);
-  std::printf("[ measured ] box on a %.0f degree slope, mu = %.2f: a = %.4f m/s^2 against g (sin - mu cos) = %.4f "
+  std::printf("[ measured ] %s box on a %.0f degree slope, mu = %.2f: a = %.4f m/s^2 against g (sin - mu cos) = %.4f "
               "(%+.3f%%), slid %.4f m\n",
-              degrees, mu, a, expected, 100 * (a / expected - 1), r.s.back());
+              name(), degrees, mu, a, expected, 100 * (a / expected - 1), r.s.back());
   EXPECT_NEAR(a, expected, 0.02 * std::abs(expected));
 }
 
-TEST(BodyContacts, BoxStaysPutWhenTheSlopeIsBelowTheFrictionAngle) {
+TEST_P(Contacts, BoxStaysPutWhenTheSlopeIsBelowTheFrictionAngle) {
   const double dx = 0.01;
-  const SlopeRun r = slide(20, 0.5, 0.3);
+  const SlopeRun r = slide(GetParam(), 20, 0.5, 0.3);
   double worst = 0;
   for (double s : r.s) worst = std::max(worst, std::abs(s));
-  std::printf("[ measured ] box on a 20 degree slope, mu = 0.5: largest displacement along the slope %.3e m "
+  std::printf("[ measured ] %s box on a 20 degree slope, mu = 0.5: largest displacement along the slope %.3e m "
               "(%.2e dx), final speed %.3e m/s\n",
-              worst, worst / dx, r.v.back());
+              name(), worst, worst / dx, r.v.back());
   EXPECT_LT(worst, 0.01 * dx);
 }
 
-TEST(BodyContacts, BodiesDrivenIntoEachOtherAndACornerDoNotInterpenetrate) {
+TEST_P(Contacts, BodiesDrivenIntoEachOtherAndACornerDoNotInterpenetrate) {
   const double dx = 0.01;
   // Gravity tilted towards -x: the lower box is pressed into the corner, the upper one falls on it
   // and both are pushed against the left wall.
@@ -378,7 +400,7 @@ TEST(BodyContacts, BodiesDrivenIntoEachOtherAndACornerDoNotInterpenetrate) {
   - {name: upper, box: {size: [0.1, 0.1]}, position: [0.2, 0.3], rotation: -20, motion: free, density: 2000,
      contact: {youngs_modulus: 3.0e10, poisson_ratio: 0.3, restitution: 0.3, friction: 0.4}}
 )";
-  fsi::Simulation sim(scene_of(yaml), cpu());
+  fsi::Simulation sim(scene_of(moved(yaml)), cpu());
   sim.start();
   const auto& st = sim.store();
   const auto& ids = sim.fields();
@@ -387,7 +409,9 @@ TEST(BodyContacts, BodiesDrivenIntoEachOtherAndACornerDoNotInterpenetrate) {
   int touched_pair = 0;
   while (sim.time() < 0.5) {
     sim.step();
-    worst_sphere = std::max(worst_sphere, sim.bodies()->last_max_overlap());
+    // The contact law's own overlap: DEM spheres, or Bullet's deepest penetration.
+    const auto* bullet = sim.bodies()->bullet();
+    worst_sphere = std::max(worst_sphere, bullet ? bullet->last_max_penetration() : sim.bodies()->last_max_overlap());
     most_substeps = std::max(most_substeps, sim.bodies()->last_substeps());
     const auto* x = st.data<float>(ids.position);
     const auto* kind = st.data<std::uint8_t>(ids.kind);
@@ -405,14 +429,14 @@ TEST(BodyContacts, BodiesDrivenIntoEachOtherAndACornerDoNotInterpenetrate) {
       for (std::size_t j : p1)
         closest = std::min(closest, std::hypot(double(x[2 * i] - x[2 * j]), double(x[2 * i + 1] - x[2 * j + 1])));
     worst_pair = std::max(worst_pair, dx - closest);
-    if (closest < dx) ++touched_pair;
+    if (closest < 1.01 * dx) ++touched_pair;  // touching, within 1% of dx (rigid Bullet contacts do not overlap)
   }
   const auto& lo = sim.bodies()->body(0);
   const auto& up = sim.bodies()->body(1);
-  std::printf("[ measured ] pile in the corner: body-body overlap <= %.3e m (%.4f dx), body-wall <= %.3e m (%.4f dx), "
+  std::printf("[ measured ] %s pile in the corner: body-body overlap <= %.3e m (%.4f dx), body-wall <= %.3e m (%.4f dx), "
               "contact spheres <= %.3e m; steps with the bodies touching %d; final x %.4f, %.4f m; up to %d body substeps "
               "per fluid step of %.3e s\n",
-              worst_pair, worst_pair / dx, worst_wall, worst_wall / dx, worst_sphere, touched_pair, lo.position().x(),
+              name(), worst_pair, worst_pair / dx, worst_wall, worst_wall / dx, worst_sphere, touched_pair, lo.position().x(),
               up.position().x(), most_substeps, sim.last_time_step());
   EXPECT_GT(touched_pair, 100) << "the upper box should land on the lower one";
   EXPECT_LT(lo.position().x(), 0.1) << "gravity should press the lower box into the corner";
@@ -425,7 +449,7 @@ TEST(BodyContacts, BodiesDrivenIntoEachOtherAndACornerDoNotInterpenetrate) {
 // The same bound when the flow drives them: a 2D dam break (0.25 x 0.3 m of water, dx = 0.01 m)
 // strikes two boxes standing on the floor near the right wall and pushes them into each other and
 // into the wall; overlaps measured on the particles as above, bound 0.1 dx.
-TEST(BodyContacts, DamBreakDrivesTwoBoxesIntoEachOtherAndTheWallWithoutInterpenetration) {
+TEST_P(Contacts, DamBreakDrivesTwoBoxesIntoEachOtherAndTheWallWithoutInterpenetration) {
   const double dx = 0.01, end = 0.8;
   const std::string yaml = R"(name: dam_boxes
 dimensions: 2
@@ -444,7 +468,7 @@ structures:
   - {name: second, box: {size: [0.06, 0.08]}, position: [0.7, 0.04], motion: free, density: 1300,
      contact: {youngs_modulus: 3.0e10, poisson_ratio: 0.3, restitution: 0.3, friction: 0.3}}
 )";
-  fsi::Simulation sim(scene_of(yaml), cpu());
+  fsi::Simulation sim(scene_of(moved(yaml)), cpu());
   sim.start();
   const auto& st = sim.store();
   const auto& ids = sim.fields();
@@ -476,10 +500,10 @@ structures:
     if (closest < dx) ++touched_pair;
     if (b.position().x() > 0.8 - 0.03 - 0.5 * dx) ++touched_wall;
   }
-  std::printf("[ measured ] dam break on two boxes: moved %.4f m and %.4f m; steps touching each other %d, the right "
+  std::printf("[ measured ] %s dam break on two boxes: moved %.4f m and %.4f m; steps touching each other %d, the right "
               "wall %d; body-body overlap <= %.3e m (%.4f dx), body-wall <= %.3e m (%.4f dx); up to %d substeps, "
               "%llu steps\n",
-              a.position().x() - a0, b.position().x() - b0, touched_pair, touched_wall, worst_pair, worst_pair / dx,
+              name(), a.position().x() - a0, b.position().x() - b0, touched_pair, touched_wall, worst_pair, worst_pair / dx,
               worst_wall, worst_wall / dx, most_substeps, static_cast<unsigned long long>(sim.steps()));
   EXPECT_GT(touched_pair, 10) << "the flow should push the first box against the second";
   EXPECT_LE(worst_pair, 0.1 * dx);
@@ -595,5 +619,8 @@ TEST(BodyContacts, MooredPipeStruckByADamBreak) {
   EXPECT_GE(closest, R) << "a water particle got inside the pipe";
   EXPECT_GT(lowest, -0.1 * dx);
 }
+
+INSTANTIATE_TEST_SUITE_P(Motion, Contacts, ::testing::Values(std::string("free"), std::string("bullet")),
+                         [](const ::testing::TestParamInfo<std::string>& i) { return i.param; });
 
 }  // namespace

@@ -49,9 +49,8 @@ PipeRun run_pipe(const std::string& scene_name, double dx, double end, double ra
                  bool bullet = false) {
   fsi::Scene scene = tools::read_scene_file(std::string(TURBID_SOURCE_DIR) + "/scenes/" + scene_name + ".yaml");
   if (bullet) {
-    // The same pipe moved by Bullet; Bullet bodies collide through Bullet, so no DEM contact material.
+    // The same pipe moved by Bullet, which takes its contact material's restitution and friction.
     scene.structures.at(0).motion = fsi::StructureSpec::Motion::bullet;
-    scene.structures.at(0).contact.given = false;
   }
   scene.particle_spacing = dx;
   if (end > 0) scene.end_time = end;
