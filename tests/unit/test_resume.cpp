@@ -135,7 +135,9 @@ ResumeRuns check_resume(const std::string& scene_text) {
                           "splits_refused", "fluid_mass_start", "fluid_mass_end", "fluid_momentum_start",
                           "fluid_momentum_end", "materials"}) {
     EXPECT_EQ(r.full.contains(key), r.resumed.contains(key)) << key;
-    if (r.full.contains(key)) EXPECT_EQ(r.full.at(key), r.resumed.at(key)) << "run.json '" << key << "' after resume";
+    if (r.full.contains(key)) {
+      EXPECT_EQ(r.full.at(key), r.resumed.at(key)) << "run.json '" << key << "' after resume";
+    }
   }
   // Every frame and every probe row must match byte for byte.
   int frames = 0;
@@ -149,8 +151,9 @@ ResumeRuns check_resume(const std::string& scene_text) {
   EXPECT_GE(frames, 6);
   EXPECT_EQ(slurp(dir / "full" / "probes.csv"), slurp(dir / "split" / "probes.csv"));
   EXPECT_EQ(slurp(dir / "full" / "particles.pvd"), slurp(dir / "split" / "particles.pvd"));
-  if (fs::exists(dir / "full" / "forces.csv"))
+  if (fs::exists(dir / "full" / "forces.csv")) {
     EXPECT_EQ(slurp(dir / "full" / "forces.csv"), slurp(dir / "split" / "forces.csv"));
+  }
   // The last checkpoint (after the resume point): every checkpointed field, including those the
   // frames leave out (mass, smoothing length, acceleration), and the saved state but the wall time.
   auto state_full = checkpoint_state(dir / "full");

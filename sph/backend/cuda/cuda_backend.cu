@@ -292,6 +292,38 @@ class CudaBackend final : public Backend {
     return loads_impl<3>(reference);
   }
 
+  // Moving structures: the bodies' states (a few hundred bytes) go up each call and the shared
+  // placement pass (sph/body_motion.hpp) moves their particles on the device.
+  bool supports_moving_bodies() const override { return true; }
+  void place_bodies(const std::vector<BodyPlacement>& bodies, bool move) override {
+    if (ids_.body_offset < 0) throw std::logic_error("place_bodies: the store has no body_offset field");
+    if (bodies.empty() || n_ == 0) return;
+    placements_.ensure(bodies.size() * sizeof(BodyPlacement));
+    TURBID_CUDA_CHECK(cudaMemcpy(placements_.get(), bodies.data(), bodies.size() * sizeof(BodyPlacement),
+                                 cudaMemcpyHostToDevice));
+    if (params_.dimensions == 2) place_impl<2>(int(bodies.size()), move);
+    else place_impl<3>(int(bodies.size()), move);
+  }
+
+  template <int D>
+  void place_impl(int body_count, bool move) {
+    auto field = [&](FieldId id) { return fields_[std::size_t(id)].get(); };
+    PlaceBodiesPass<D> pass;
+    pass.position = static_cast<Vec<D>*>(field(ids_.position));
+    pass.velocity = static_cast<Vec<D>*>(field(ids_.velocity));
+    pass.kind = static_cast<const std::uint8_t*>(field(ids_.kind));
+    pass.body = static_cast<const std::uint8_t*>(field(ids_.body));
+    pass.offset = static_cast<const Vec<D>*>(field(ids_.body_offset));
+    if (ids_.body_normal >= 0 && ids_.boundary_normal >= 0) {
+      pass.boundary_normal = static_cast<Vec<D>*>(field(ids_.boundary_normal));
+      pass.normal0 = static_cast<const Vec<D>*>(field(ids_.body_normal));
+    }
+    pass.bodies = placements_.as<BodyPlacement>();
+    pass.body_count = body_count;
+    pass.move = move;
+    launch(D == 2 ? "PlaceBodiesPass<2>" : "PlaceBodiesPass<3>", n_, pass);
+  }
+
   bool supports_splitting() const override { return true; }
   SplitCounts split(const SplitParams& rules) override {
     return params_.dimensions == 2 ? split_impl<2>(rules) : split_impl<3>(rules);
@@ -650,6 +682,7 @@ class CudaBackend final : public Backend {
   DeviceBuffer reduce_in_, result_, temp_;
   DeviceBuffer split_slots_, split_rule_, split_first_, split_tally_;  // splitting only, from the first split
   DeviceBuffer relax_zone_, relax_shift_, relax_moment_;  // relaxation after a split, from the first one
+  DeviceBuffer placements_;  // moving structures' BodyPlacement, one per structure
 };
 
 #undef TURBID_CUB_CALL
