@@ -44,27 +44,28 @@ Eigen::Vector3d pushed(const std::string& motion, const std::string& backend, in
   return x;
 }
 
+// The pushed box's path on the GPU against the CPU's, bound 1e-3 of its displacement.
+void expect_push_parity(const std::string& motion) {
+  double moved = 0;
+  const Eigen::Vector3d cpu = pushed(motion, "cpu", 100, &moved);
+  const Eigen::Vector3d gpu = pushed(motion, "cuda", 100, nullptr);
+  std::printf("[ measured ] pushed %s box, 100 steps: moved %.4e m; cuda - cpu %.3e m\n", motion.c_str(), moved,
+              (gpu - cpu).norm());
+  ASSERT_GT(moved, 1e-3);
+  EXPECT_LE((gpu - cpu).norm(), 1e-3 * moved);
+}
+
 TEST(CudaBodies, PushedFreeBoxFollowsTheCpuPath) {
   std::string reason;
   if (sph::cuda_device_count(&reason) == 0) GTEST_SKIP() << reason;
-  double moved = 0;
-  const Eigen::Vector3d cpu = pushed("free", "cpu", 100, &moved);
-  const Eigen::Vector3d gpu = pushed("free", "cuda", 100, nullptr);
-  std::printf("[ measured ] pushed free box, 100 steps: moved %.4e m; cuda - cpu %.3e m\n", moved, (gpu - cpu).norm());
-  ASSERT_GT(moved, 1e-3);
-  EXPECT_LE((gpu - cpu).norm(), 1e-3 * moved);
+  expect_push_parity("free");
 }
 
 TEST(CudaBodies, PushedBulletBoxFollowsTheCpuPath) {
   std::string reason;
   if (sph::cuda_device_count(&reason) == 0) GTEST_SKIP() << reason;
   if (!fsi::bullet_available()) GTEST_SKIP() << "built without Bullet";
-  double moved = 0;
-  const Eigen::Vector3d cpu = pushed("bullet", "cpu", 100, &moved);
-  const Eigen::Vector3d gpu = pushed("bullet", "cuda", 100, nullptr);
-  std::printf("[ measured ] pushed bullet box, 100 steps: moved %.4e m; cuda - cpu %.3e m\n", moved, (gpu - cpu).norm());
-  ASSERT_GT(moved, 1e-3);
-  EXPECT_LE((gpu - cpu).norm(), 1e-3 * moved);
+  expect_push_parity("bullet");
 }
 
 TEST(CudaBodies, PrescribedCylinderParticlesSitWhereTheCpuPutsThem) {
