@@ -39,14 +39,16 @@ BodyContacts::BodyContacts(std::vector<BodyContactShape> shapes, const std::vect
   wall_law_.resize(n);
   fixed_law_.assign(n, std::vector<Law>(world_.fixed.size()));
   body_law_.assign(n, std::vector<Law>(n));
-  for (const auto& f : world_.fixed) {
-    Eigen::Vector3d lo = Eigen::Vector3d::Constant(kInfinity), hi = Eigen::Vector3d::Constant(-kInfinity);
-    for (const auto& c : f.centres) {
-      lo = lo.cwiseMin(c);
-      hi = hi.cwiseMax(c);
-    }
-    fixed_lo_.push_back(lo.array() - f.radius);
-    fixed_hi_.push_back(hi.array() + f.radius);
+  const std::size_t obstacles = world_.fixed.size();
+  fixed_lo_.resize(obstacles);
+  fixed_hi_.resize(obstacles);
+  fixed_now_.resize(obstacles);
+  motion_.resize(obstacles);
+  obstacle_speed_.assign(obstacles, 0.0);
+  for (std::size_t j = 0; j < obstacles; ++j) {
+    ObstacleMotion at_rest;
+    at_rest.reference = world_.fixed[j].reference;
+    move_obstacle(j, at_rest);
   }
   for (std::size_t k = 0; k < n; ++k) {
     const BodyContactShape& s = shapes_[k];
@@ -76,6 +78,30 @@ BodyContacts::BodyContacts(std::vector<BodyContactShape> shapes, const std::vect
       body_law_[l][k] = {make_contact_law(side_of(o.material, o.radius, masses_[l]), me, e, mu), true};
     }
   }
+}
+
+void BodyContacts::move_obstacle(std::size_t j, const ObstacleMotion& m) {
+  const FixedContactShape& f = world_.fixed[j];
+  std::vector<Eigen::Vector3d>& now = fixed_now_[j];
+  now.resize(f.centres.size());
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(kInfinity), hi = Eigen::Vector3d::Constant(-kInfinity);
+  double reach = 0;
+  for (std::size_t i = 0; i < f.centres.size(); ++i) {
+    const Eigen::Vector3d arm = m.rotation * (f.centres[i] - f.reference);
+    now[i] = f.prescribed >= 0 ? Eigen::Vector3d(m.reference + arm) : f.centres[i];
+    lo = lo.cwiseMin(now[i]);
+    hi = hi.cwiseMax(now[i]);
+    reach = std::max(reach, arm.norm() + f.radius);
+  }
+  fixed_lo_[j] = lo.array() - f.radius;
+  fixed_hi_[j] = hi.array() + f.radius;
+  motion_[j] = m;
+  obstacle_speed_[j] = m.velocity.norm() + m.angular_velocity.norm() * reach;
+}
+
+void BodyContacts::move_prescribed(const std::function<ObstacleMotion(std::size_t structure)>& where) {
+  for (std::size_t j = 0; j < world_.fixed.size(); ++j)
+    if (world_.fixed[j].prescribed >= 0) move_obstacle(j, where(std::size_t(world_.fixed[j].prescribed)));
 }
 
 void BodyContacts::add(const ContactLaw& law, const ContactGeometry& g, const ContactKey& key, const RigidBody& body,
@@ -177,16 +203,19 @@ void BodyContacts::evaluate(const std::vector<std::optional<RigidBody>>& bodies,
         g.point = c - (r - 0.5 * g.overlap) * g.normal;
         add(wall_law_[k].law, g, {int(k), int(i), 1, int(j), 0}, b, zero, nullptr, k, k, dt, out, next);
       }
-      // (c) fixed structures.
+      // (c) fixed and prescribed structures.
       for (std::size_t j = 0; j < world_.fixed.size(); ++j) {
         const FixedContactShape& o = world_.fixed[j];
-        if (o.centres.empty()) continue;
+        const std::vector<Eigen::Vector3d>& at = fixed_now_[j];
+        if (at.empty()) continue;
         if (((c.array() + r) < fixed_lo_[j].array()).head(d).any() || ((c.array() - r) > fixed_hi_[j].array()).head(d).any())
           continue;
-        for (std::size_t m = 0; m < o.centres.size(); ++m) {
-          if ((c - o.centres[m]).squaredNorm() >= (r + o.radius) * (r + o.radius)) continue;
-          const ContactGeometry g = sphere_sphere(c, r, o.centres[m], o.radius);
-          add(fixed_law_[k][j].law, g, {int(k), int(i), 2, int(j), int(m)}, b, zero, nullptr, k, k, dt, out, next);
+        const ObstacleMotion& mo = motion_[j];
+        for (std::size_t m = 0; m < at.size(); ++m) {
+          if ((c - at[m]).squaredNorm() >= (r + o.radius) * (r + o.radius)) continue;
+          const ContactGeometry g = sphere_sphere(c, r, at[m], o.radius);
+          const Eigen::Vector3d v2 = mo.velocity + mo.angular_velocity.cross(g.point - mo.reference);
+          add(fixed_law_[k][j].law, g, {int(k), int(i), 2, int(j), int(m)}, b, v2, nullptr, k, k, dt, out, next);
         }
       }
     }
@@ -268,7 +297,8 @@ double BodyContacts::max_substep(const std::vector<std::optional<RigidBody>>& bo
     if (!world_.faces.empty() || !world_.boxes.empty())
       h = std::min(h, step(wall_law_[k].law, per_sphere_mass, speed[k], load[k], body_mass));
     for (std::size_t j = 0; j < world_.fixed.size(); ++j)
-      if (fixed_law_[k][j].valid) h = std::min(h, step(fixed_law_[k][j].law, per_sphere_mass, speed[k], load[k], body_mass));
+      if (fixed_law_[k][j].valid)
+        h = std::min(h, step(fixed_law_[k][j].law, per_sphere_mass, speed[k] + obstacle_speed_[j], load[k], body_mass));
     for (std::size_t l = k + 1; l < n; ++l) {
       if (m_eff[l] == 0 || !body_law_[k][l].valid) continue;
       const double reduced = 1.0 / (1.0 / m_eff[k] + 1.0 / m_eff[l]);

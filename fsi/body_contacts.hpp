@@ -12,6 +12,9 @@
 //    segment extruded across y), one-sided, with the wall's fluid side as normal; solid boxes as
 //    boxes; fixed structures by their surface-layer particles as spheres of radius dx/2 (a fixed
 //    sphere structure, and a fixed 2D cylinder, by its exact sphere).
+//  - Prescribed structures (motion: prescribed) as the fixed ones, their spheres carried along the
+//    path: the coupling moves them to each substep's time (move_obstacle) and a contact sees the
+//    path's velocity at its point. They take no reaction (the path is imposed), like a wall.
 //  - Body-body: sphere pairs of two bodies whose bounding spheres overlap, all pairs tested.
 // Faces of one wall share their vertices and edges: a sphere takes every face contact of a wall
 // whose foot lies inside the face, and only when it has none, the single deepest edge or vertex
@@ -29,6 +32,7 @@
 // obstacle sphere), from one evaluation to the next, and dropped when the contact ends.
 #pragma once
 #include <array>
+#include <functional>
 #include <map>
 #include <optional>
 #include <vector>
@@ -71,18 +75,35 @@ struct ContactBox {
   Eigen::Vector3d min = Eigen::Vector3d::Zero(), max = Eigen::Vector3d::Zero();
 };
 
-// A fixed structure as obstacle: spheres in world coordinates.
+// A fixed or prescribed structure as obstacle: spheres in world coordinates (a prescribed one's at
+// t = 0, moved by BodyContacts::move_obstacle).
 struct FixedContactShape {
   std::vector<Eigen::Vector3d> centres;
   double radius = 0;
   std::optional<ContactMaterial> material;  // none: rigid, the body's restitution and friction
+  int prescribed = -1;                      // the structure of a prescribed obstacle; -1: fixed
+  Eigen::Vector3d reference = Eigen::Vector3d::Zero();  // a prescribed obstacle's reference point at t = 0 [m]
+};
+
+// Where a prescribed obstacle is at some time: its reference point, its rotation from t = 0 (about
+// the reference point), the reference point's velocity and the angular velocity (world).
+struct ObstacleMotion {
+  Eigen::Vector3d reference = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
 };
 
 struct ContactWorld {
   int dims = 2;
   std::vector<ContactFace> faces;         // grouped by wall, walls in scene order
   std::vector<ContactBox> boxes;
-  std::vector<FixedContactShape> fixed;   // one per fixed structure (any order, kept)
+  std::vector<FixedContactShape> fixed;   // one per fixed or prescribed structure (any order, kept)
+  bool has_prescribed() const {
+    for (const auto& f : fixed)
+      if (f.prescribed >= 0) return true;
+    return false;
+  }
 };
 
 // Contact key: body, its sphere, obstacle kind (0 face, 1 box, 2 fixed structure, 3 body), obstacle
@@ -97,6 +118,13 @@ class BodyContacts {
 
   bool any() const { return active_count_ > 0; }
   const BodyContactShape& shape(std::size_t k) const { return shapes_[k]; }
+  const ContactWorld& world() const { return world_; }
+
+  // Puts the prescribed obstacle world().fixed[j] where `m` says, for the evaluations that follow
+  // (its spheres x_ref + R (c0 - x_ref0), the velocity at a contact point v + w x (p - x_ref)).
+  void move_obstacle(std::size_t j, const ObstacleMotion& m);
+  // Moves every prescribed obstacle to where(structure).
+  void move_prescribed(const std::function<ObstacleMotion(std::size_t structure)>& where);
 
   // Adds the contact wrench on every body to `out` (one per structure, about its centre of mass).
   // `dt` advances the tangential springs (0: evaluate only, as at the start of a step's substeps).
@@ -138,7 +166,10 @@ class BodyContacts {
   std::vector<double> masses_;
   std::vector<double> bounding_;      // bounding radius of each shape about the centre of mass
   ContactWorld world_;
-  std::vector<Eigen::Vector3d> fixed_lo_, fixed_hi_;  // bounding boxes of the fixed shapes
+  std::vector<Eigen::Vector3d> fixed_lo_, fixed_hi_;  // bounding boxes of the fixed shapes (now)
+  std::vector<std::vector<Eigen::Vector3d>> fixed_now_;  // their spheres' centres now
+  std::vector<ObstacleMotion> motion_;                   // their motion now (fixed: at rest)
+  std::vector<double> obstacle_speed_;                   // the fastest point of each now [m/s]
   int active_count_ = 0;
   std::vector<Law> wall_law_;                    // per body: faces and boxes
   std::vector<std::vector<Law>> fixed_law_;      // per body, per fixed shape

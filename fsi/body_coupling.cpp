@@ -39,6 +39,15 @@ std::vector<Wrench> BodyCoupling::fast_load(double dt, std::vector<Wrench>* cont
 
 BodyCoupling::~BodyCoupling() = default;
 
+void BodyCoupling::set_obstacle_motion(ObstacleMotionAt motion, std::function<double()> clock) {
+  obstacle_motion_ = std::move(motion);
+  clock_ = std::move(clock);
+  if (bullet_ && obstacle_motion_) {
+    const double t = clock_();
+    bullet_->place_prescribed([&](std::size_t k) { return obstacle_motion_(k, t); });
+  }
+}
+
 void BodyCoupling::set_bullet(std::unique_ptr<BulletWorld> world) {
   bullet_ = std::move(world);  // both at rest at the centres of mass
 }
@@ -48,6 +57,10 @@ bool BodyCoupling::is_bullet(std::size_t k) const { return bullet_ && bodies_[k]
 void BodyCoupling::restored() {
   for (std::size_t k = 0; k < bodies_.size(); ++k)
     if (is_bullet(k)) bullet_->read_mirror(k, *bodies_[k]);
+  if (bullet_ && obstacle_motion_) {
+    const double t = clock_();
+    bullet_->place_prescribed([&](std::size_t k) { return obstacle_motion_(k, t); });
+  }
 }
 
 Wrench BodyCoupling::total_load(std::size_t k) const {
@@ -86,6 +99,10 @@ void BodyCoupling::after_kick(sph::Backend& backend, double half_dt) {
       // The step's first half-kick: Bullet steps now by the whole dt (2 half_dt is exact) with the
       // impulses of this and the last half-kick; the particles carry its half-step velocity, hinge
       // and contact impulses included, through the continuity pass. Its positions wait for the drift.
+      if (obstacle_motion_) {
+        const double t_end = clock_() + 2 * half_dt;
+        bullet_->move_prescribed([&](std::size_t k) { return obstacle_motion_(k, t_end); });
+      }
       bullet_->step(2 * half_dt);
       for (std::size_t k = 0; k < bodies_.size(); ++k)
         if (is_bullet(k)) {
@@ -110,6 +127,12 @@ void BodyCoupling::after_drift(sph::Backend& backend, double dt) {
     place(backend, true);
     return;
   }
+  // Prescribed obstacles at the time of each evaluation: t(n), then the end of each substep.
+  const double t0 = clock_ ? clock_() : 0.0;
+  const auto move_obstacles = [&](double t) {
+    if (contacts_ && obstacle_motion_) contacts_->move_prescribed([&](std::size_t k) { return obstacle_motion_(k, t); });
+  };
+  move_obstacles(t0);
   // The substep: the smallest of the constraints' and contacts' limits (body_constraints.hpp,
   // body_contacts.hpp), at the state after the slow half-kick.
   double h = dt;
@@ -138,6 +161,7 @@ void BodyCoupling::after_drift(sph::Backend& backend, double dt) {
       impulse[k].torque += 0.5 * sub * contact[k].torque;
       bodies_[k]->drift(sub);
     }
+    move_obstacles(t0 + (s + 1) * sub);
     fast = fast_load(sub, &contact);
     if (contacts_) last_max_overlap_ = std::max(last_max_overlap_, contacts_->last_max_overlap());
     for (std::size_t k = 0; k < bodies_.size(); ++k) {

@@ -32,6 +32,7 @@
 // continuity pass) and Bullet's x(n+1), q(n+1) at the drift. The second half-kick kicks the mirror
 // as a free body, so its velocity at the end of a step is the synchronised one.
 #pragma once
+#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -82,6 +83,12 @@ class BodyCoupling final : public sph::StepCoupling {
   // after the resume needs (the per-particle structure forces are not checkpointed).
   void restore_fluid_load(std::size_t k, const Wrench& w) { fluid_[k] = w; }
 
+  // Prescribed structures as contact obstacles (body_contacts.hpp, bullet_world.hpp): where
+  // structure k is at time t, and the solver's clock (t(n) during a step). The DEM contacts take
+  // them at each substep's time, Bullet at the end of its step. Without it they stay at t = 0.
+  using ObstacleMotionAt = std::function<ObstacleMotion(std::size_t structure, double t)>;
+  void set_obstacle_motion(ObstacleMotionAt motion, std::function<double()> clock);
+
   // Fast forces (see above): constraints, and contacts (kept when some body has a contact material).
   void set_fast_forces(std::vector<BodyConstraint> constraints, std::unique_ptr<BodyContacts> contacts);
   bool has_fast_forces() const { return !constraints_.empty() || contacts_; }
@@ -109,6 +116,8 @@ class BodyCoupling final : public sph::StepCoupling {
   int last_substeps_ = 0;
   double last_max_overlap_ = 0;
   std::unique_ptr<BulletWorld> bullet_;
+  ObstacleMotionAt obstacle_motion_;
+  std::function<double()> clock_;
   bool drifted_ = false;  // a drift since the last half-kick: the next half-kick is the step's second
 };
 

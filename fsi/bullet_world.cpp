@@ -229,6 +229,8 @@ struct BulletWorld::Impl {
   std::vector<std::unique_ptr<btTypedConstraint>> hinges;
   std::vector<std::unique_ptr<btCollisionShape>> obstacle_shapes;  // children first, then their compounds
   std::vector<std::unique_ptr<btRigidBody>> obstacles;
+  std::vector<std::unique_ptr<btDefaultMotionState>> motion_states;         // of the kinematic obstacles
+  std::vector<std::pair<std::size_t, btRigidBody*>> kinematic;             // (structure, body)
   double max_penetration = 0;
 
   ~Impl() {
@@ -262,21 +264,31 @@ struct BulletWorld::Impl {
   void add_constraint(const ConstraintSpec& c, const std::vector<bool>& other_moving);
   void spring_impulses(double duration);
   void add_obstacles(const ContactWorld& w);
-  void add_obstacle(std::unique_ptr<btCollisionShape> shape, const btTransform& where,
-                    const std::optional<ContactMaterial>& material);
+  btRigidBody& add_obstacle(std::unique_ptr<btCollisionShape> shape, const btTransform& where,
+                            const std::optional<ContactMaterial>& material, bool kinematic = false);
   void collect_contacts(double dt);
 };
 
-void BulletWorld::Impl::add_obstacle(std::unique_ptr<btCollisionShape> shape, const btTransform& where,
-                                     const std::optional<ContactMaterial>& material) {
-  btRigidBody::btRigidBodyConstructionInfo info(0.0, nullptr, shape.get(), btVector3(0, 0, 0));
+btRigidBody& BulletWorld::Impl::add_obstacle(std::unique_ptr<btCollisionShape> shape, const btTransform& where,
+                                             const std::optional<ContactMaterial>& material, bool kinematic) {
+  btDefaultMotionState* state = nullptr;
+  if (kinematic) {
+    motion_states.push_back(std::make_unique<btDefaultMotionState>(where));
+    state = motion_states.back().get();
+  }
+  btRigidBody::btRigidBodyConstructionInfo info(0.0, state, shape.get(), btVector3(0, 0, 0));
   info.m_startWorldTransform = where;
-  auto r = std::make_unique<btRigidBody>(info);  // mass 0: static
+  auto r = std::make_unique<btRigidBody>(info);  // mass 0: static, or kinematic
   r->setRestitution(material ? material->restitution : 1.0);
   r->setFriction(material ? material->friction : kRigidFriction);
+  if (kinematic) {
+    r->setCollisionFlags(r->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
+    r->setActivationState(DISABLE_DEACTIVATION);
+  }
   world->addRigidBody(r.get(), kObstacleGroup, kContactGroup);
   obstacle_shapes.push_back(std::move(shape));
   obstacles.push_back(std::move(r));
+  return *obstacles.back();
 }
 
 void BulletWorld::Impl::add_obstacles(const ContactWorld& w) {
@@ -318,12 +330,19 @@ void BulletWorld::Impl::add_obstacles(const ContactWorld& w) {
     } else {
       child = std::make_unique<btSphereShape>(f.radius);
     }
+    // A prescribed obstacle's spheres sit about its reference point, its body's origin.
+    const bool moving = f.prescribed >= 0;
+    Eigen::Vector3d origin = moving ? f.reference : Eigen::Vector3d::Zero();
+    if (dims == 2) origin.z() = 0;
     auto compound = std::make_unique<btCompoundShape>(true, int(f.centres.size()));
-    for (const auto& c : f.centres)
-      compound->addChildShape(btTransform(btMatrix3x3::getIdentity(), to_bt(Eigen::Vector3d(c.x(), c.y(), dims == 2 ? 0.0 : c.z()))),
-                              child.get());
+    for (const auto& c : f.centres) {
+      Eigen::Vector3d local = c - origin;
+      if (dims == 2) local.z() = 0;
+      compound->addChildShape(btTransform(btMatrix3x3::getIdentity(), to_bt(local)), child.get());
+    }
     obstacle_shapes.push_back(std::move(child));
-    add_obstacle(std::move(compound), btTransform::getIdentity(), f.material);
+    btRigidBody& r = add_obstacle(std::move(compound), btTransform(btMatrix3x3::getIdentity(), to_bt(origin)), f.material, moving);
+    if (moving) kinematic.emplace_back(std::size_t(f.prescribed), &r);
   }
 }
 
@@ -642,6 +661,28 @@ void BulletWorld::step(double dt) {
 }
 
 Wrench BulletWorld::contact_load(std::size_t structure) const { return impl_->body_of(structure).contact; }
+
+namespace {
+btTransform pose_of(const ObstacleMotion& m, int dims) {
+  Eigen::Vector3d x = m.reference;
+  if (dims == 2) x.z() = 0;
+  return btTransform(to_bt_matrix(m.rotation), to_bt(x));
+}
+}  // namespace
+
+void BulletWorld::move_prescribed(const std::function<ObstacleMotion(std::size_t structure)>& where) {
+  for (auto& [structure, body] : impl_->kinematic)
+    body->getMotionState()->setWorldTransform(pose_of(where(structure), impl_->dims));
+}
+
+void BulletWorld::place_prescribed(const std::function<ObstacleMotion(std::size_t structure)>& where) {
+  for (auto& [structure, body] : impl_->kinematic) {
+    const btTransform T = pose_of(where(structure), impl_->dims);
+    body->getMotionState()->setWorldTransform(T);
+    body->setWorldTransform(T);
+    body->setInterpolationWorldTransform(T);
+  }
+}
 double BulletWorld::last_max_penetration() const { return impl_->max_penetration; }
 std::size_t BulletWorld::obstacle_count() const { return impl_->obstacles.size(); }
 
@@ -703,6 +744,8 @@ BulletWorld::BulletWorld(int, const Eigen::Vector3d&, const std::vector<BulletBo
   throw std::runtime_error(kNoBulletMessage);
 }
 Wrench BulletWorld::contact_load(std::size_t) const { throw std::runtime_error(kNoBulletMessage); }
+void BulletWorld::move_prescribed(const std::function<ObstacleMotion(std::size_t)>&) {}
+void BulletWorld::place_prescribed(const std::function<ObstacleMotion(std::size_t)>&) {}
 double BulletWorld::last_max_penetration() const { return 0; }
 std::size_t BulletWorld::obstacle_count() const { return 0; }
 BulletWorld::~BulletWorld() = default;

@@ -29,7 +29,8 @@
 // the scene's obstacles, the same ContactWorld the DEM contacts use (scene_interactions.hpp): a
 // container face or polyline segment as a slab behind the face (a box as thick as the face is long,
 // so nothing tunnels through it), a solid box as its box, a fixed structure as the spheres of its
-// surface layer (dx/2, as in the DEM contacts; its exact sphere for a sphere or 2D cylinder). In 2D
+// surface layer (dx/2, as in the DEM contacts; its exact sphere for a sphere or 2D cylinder), a
+// prescribed structure likewise as a kinematic body that follows its path. In 2D
 // every obstacle spans z in [-1, 1] m. Bullet's contacts are rigid: a material's restitution and
 // friction are used, its Young's modulus and Poisson ratio are not (they set the DEM contacts'
 // stiffness). A pair takes the smaller restitution and the smaller friction of its two sides (the
@@ -82,6 +83,7 @@
 // Physics only: no I/O. Not thread-safe; one world per Simulation.
 #pragma once
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -168,6 +170,12 @@ class BulletWorld {
   // the centre of mass, world frame) [N], [N m], and the deepest penetration Bullet left between
   // any two touching objects at the end of that step [m] (0 when none).
   Wrench contact_load(std::size_t structure) const;
+  // Prescribed structures among the obstacles are kinematic bodies: move_prescribed puts each where
+  // where(structure) says for the next step (Bullet gives it the velocity of that move over the
+  // step: the path's mean velocity); place_prescribed puts it there at rest in the path (a resumed
+  // run, so that the next step's move starts from there).
+  void move_prescribed(const std::function<ObstacleMotion(std::size_t structure)>& where);
+  void place_prescribed(const std::function<ObstacleMotion(std::size_t structure)>& where);
   double last_max_penetration() const;
   std::size_t obstacle_count() const;
 

@@ -102,8 +102,13 @@ ContactWorld contact_world(const Scene& scene, const SurfaceLayers& surface) {
   const double dx = scene.particle_spacing;
   for (std::size_t k = 0; k < scene.structures.size(); ++k) {
     const StructureSpec& st = scene.structures[k];
-    if (st.motion != StructureSpec::Motion::fixed) continue;
+    const bool prescribed = st.motion == StructureSpec::Motion::prescribed;
+    if (st.motion != StructureSpec::Motion::fixed && !prescribed) continue;
     FixedContactShape f;
+    if (prescribed) {
+      f.prescribed = int(k);
+      f.reference = vec(st.reference_point);
+    }
     if (st.contact.given) f.material = material_of(st.contact);
     if (contacts_as_sphere(scene, st)) {
       f.centres = {vec(st.position)};

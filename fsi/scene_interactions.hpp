@@ -21,7 +21,8 @@ using SurfaceLayers = std::vector<std::vector<Eigen::Vector3d>>;
 // Whether a structure contacts as its exact sphere (a 3D sphere; a 2D sphere or cylinder, a circle).
 bool contacts_as_sphere(const Scene& scene, const StructureSpec& st);
 
-// Walls (container faces, polyline segments, solid boxes) and fixed structures as obstacles.
+// Walls (container faces, polyline segments, solid boxes) and fixed and prescribed structures as
+// obstacles (the prescribed ones at t = 0, with their structure index and reference point).
 ContactWorld contact_world(const Scene& scene, const SurfaceLayers& surface);
 
 // Contacts of the free bodies, or nullptr when no moving structure has a contact material.

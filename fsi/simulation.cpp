@@ -616,6 +616,20 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
       chain_->add(bodies_.get());
       chain_->add(prescribed_.get());
       solver_->set_coupling(chain_.get());
+      // The prescribed structures are contact obstacles of the moving bodies, along their paths.
+      const PrescribedCoupling* paths = prescribed_.get();
+      bodies_->set_obstacle_motion(
+          [paths](std::size_t k, double t) {
+            const BodyKinematics b = paths->kinematics(k, t);
+            ObstacleMotion m;
+            m.reference = Eigen::Vector3d(b.position[0], b.position[1], b.position[2]);
+            m.rotation = Eigen::Quaterniond(b.orientation[0], b.orientation[1], b.orientation[2], b.orientation[3])
+                             .toRotationMatrix();
+            m.velocity = Eigen::Vector3d(b.velocity[0], b.velocity[1], b.velocity[2]);
+            m.angular_velocity = Eigen::Vector3d(b.angular_velocity[0], b.angular_velocity[1], b.angular_velocity[2]);
+            return m;
+          },
+          [solver] { return solver->time(); });
     } else {
       solver_->set_coupling(prescribed_.get());
     }

@@ -239,6 +239,33 @@ TEST_P(Contacts, DiscReboundsFromASolidBoxAndFromAFixedStructure) {
   EXPECT_EQ(std::find(cols.begin(), cols.end(), "post.contact_Fy [N/m]"), cols.end()) << "a fixed structure has no body";
 }
 
+// A prescribed paddle (a 0.1 x 0.2 m box moving at V = 0.5 m/s along +x, rigid) strikes a disc at
+// rest, no gravity: in the paddle's frame the disc arrives at -V and leaves at e V, so it leaves at
+// v = (1 + e) V (Newton's restitution against an infinite mass), within 5%; the paddle's spheres
+// move along its path through the substeps (DEM) or as a kinematic Bullet body.
+TEST_P(Contacts, PrescribedPaddleKicksADiscWithTheRestitution) {
+  const double e = 0.5, V = 0.5;
+  fsi::Simulation sim(scene_of(moved(head("paddle", "[0, 0]", 0.6) + "walls:\n" + kFarTank + R"(structures:
+  - {name: ball, sphere: {radius: 0.05}, position: [0.5, 0.3], motion: free, density: 1000,
+     contact: {youngs_modulus: 1.0e8, poisson_ratio: 0.3, restitution: 0.5, friction: 0.3}}
+  - {name: paddle, box: {size: [0.1, 0.2]}, position: [0.2, 0.3], motion: prescribed, path: {velocity: [0.5, 0]}}
+)")),
+                      cpu());
+  sim.start();
+  bool touched = false, left = false;
+  while (sim.time() < 0.6 && !left) {
+    sim.step();
+    const bool touching = sim.bodies()->contact_load(0).force.norm() > 0;
+    touched = touched || touching;
+    left = touched && !touching;
+  }
+  const double v_out = sim.bodies()->body(0).velocity().x();
+  std::printf("[ measured ] %s disc kicked by a paddle at %.2f m/s: leaves at %.4f m/s against (1 + e) V = %.4f (%+.2f%%)\n",
+              name(), V, v_out, (1 + e) * V, 100 * (v_out / ((1 + e) * V) - 1));
+  ASSERT_TRUE(left) << "the paddle should have struck the disc and let it go by t = 0.6 s";
+  EXPECT_NEAR(v_out, (1 + e) * V, 0.05 * (1 + e) * V);
+}
+
 // A clump's flat face lands on all its bottom spheres at once: they act in parallel and share the
 // mass (body_contacts.hpp), so the box rebounds with the law's restitution too (within 5%).
 TEST_P(Contacts, BoxLandingFlatReboundsWithTheRestitution) {
