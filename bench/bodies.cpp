@@ -1,9 +1,11 @@
 // What moving structures cost (issue #8, docs/performance.md):
 //
-//  - BodiesInTank2D/N/B: a 2D tank with 100 small boxes in the water, N of them moving (B = 0: the
+//  - BodiesInTank2D/N/B/C: a 2D tank with 100 small boxes in the water, N of them moving (B = 0: the
 //    built-in integrator, motion: free; B = 1: motion: bullet) and the rest fixed. Every case has
 //    the same particles, so the step time against N = 0 is the cost of coupling N bodies: placing
 //    their particles twice per step, summing the fluid load on each and integrating it.
+//    BodiesInTank2D/100/B/1: the same 100 moving boxes with contact materials (DEM substeps and
+//    contact search, or Bullet's collision detection against the walls and each other).
 //  - FixedStructure3D: the 3D dam break with its obstacle as a fixed *structure* (not a wall), so
 //    the structure code paths (body id, force sums) run. Built at the commit before issue #8 and at
 //    the current one, its median step time gives the "fixed structures pay nothing" ratio.
@@ -33,7 +35,7 @@ turbid::fsi::RunOptions bench_options() {
 
 // 1.2 m x 1.0 m tank, water 0.95 m deep at dx = 0.01 m, 10 x 10 boxes of 0.03 m at 0.09 m pitch,
 // density 1000 kg/m^3 (neutral: they drift slowly, so the fluid stays the same as N varies).
-Scene bodies_in_tank_2d(int free_count, bool bullet) {
+Scene bodies_in_tank_2d(int free_count, bool bullet, bool contacts = false) {
   Scene s;
   s.name = "bodies_in_tank_2d";
   s.dimensions = 2;
@@ -65,6 +67,12 @@ Scene bodies_in_tank_2d(int free_count, bool bullet) {
     if (k < free_count) {
       st.motion = bullet ? StructureSpec::Motion::bullet : StructureSpec::Motion::free;
       st.density = 1000;
+      if (contacts) {
+        st.contact.given = true;
+        st.contact.youngs_modulus = 1e8;  // the DEM's; Bullet's contacts are rigid
+        st.contact.restitution = 0.5;
+        st.contact.friction = 0.3;
+      }
     }
     s.structures.push_back(st);
   }
@@ -78,7 +86,7 @@ void BodiesInTank2D(benchmark::State& state) {
     state.SkipWithError("built without Bullet");
     return;
   }
-  Simulation sim(bodies_in_tank_2d(int(state.range(0)), bullet), bench_options());
+  Simulation sim(bodies_in_tank_2d(int(state.range(0)), bullet, state.range(2) != 0), bench_options());
   sim.start();
   for (int i = 0; i < 5; ++i) sim.step();
   for (auto _ : state) sim.step();
@@ -140,5 +148,9 @@ void FixedStructure3D(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BodiesInTank2D)->Args({0, 0})->Args({1, 0})->Args({10, 0})->Args({100, 0})->Args({1, 1})->Args({10, 1})->Args({100, 1})->Unit(benchmark::kMillisecond)->Iterations(200)->UseRealTime();
+BENCHMARK(BodiesInTank2D)
+    ->Args({0, 0, 0})->Args({1, 0, 0})->Args({10, 0, 0})->Args({100, 0, 0})
+    ->Args({1, 1, 0})->Args({10, 1, 0})->Args({100, 1, 0})
+    ->Args({100, 0, 1})->Args({100, 1, 1})
+    ->Unit(benchmark::kMillisecond)->Iterations(200)->UseRealTime();
 BENCHMARK(FixedStructure3D)->Unit(benchmark::kMillisecond)->Iterations(20)->UseRealTime();
