@@ -96,6 +96,7 @@ struct ObstacleMotion {
 
 struct ContactWorld {
   int dims = 2;
+  double spacing = 0;                     // the scene's particle spacing dx [m] (0: unknown)
   std::vector<ContactFace> faces;         // grouped by wall, walls in scene order
   std::vector<ContactBox> boxes;
   std::vector<FixedContactShape> fixed;   // one per fixed or prescribed structure (any order, kept)

@@ -88,8 +88,15 @@ void BodyCoupling::place(sph::Backend& backend, bool move) const {
 }
 
 void BodyCoupling::after_kick(sph::Backend& backend, double half_dt) {
-  for (std::size_t k = 0; k < bodies_.size(); ++k)
-    if (bodies_[k]) bodies_[k]->kick(half_dt, total_load(k));
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    if (!bodies_[k]) continue;
+    Wrench load = total_load(k);
+    // A bullet body's mirror, kicked alone in the step's second half-kick (the first is overwritten
+    // by Bullet's velocity), takes Bullet's mean contact force too, so a body at rest on a wall
+    // reports v = 0, not -g dt/2.
+    if (drifted_ && is_bullet(k)) load += contact_mean_[k];
+    bodies_[k]->kick(half_dt, load);
+  }
   if (bullet_) {
     std::vector<Wrench> loads(bodies_.size());
     for (std::size_t k = 0; k < bodies_.size(); ++k)

@@ -159,7 +159,7 @@ btMatrix3x3 to_bt_matrix(const Eigen::Matrix3d& m) {
 constexpr double kHalfDepth2d = 0.5;  // 2D shapes span one metre of depth
 constexpr double kObstacleHalfDepth2d = 1.0;  // 2D obstacles reach beyond the bodies' depth
 constexpr double kBulletMargin = 0.04;
-constexpr double kTouchDistance = 1e-9;  // [m] see the constructor
+constexpr double kTouchDistance = 1e-6;  // [m] contact processing threshold, see the constructor
 // Friction of an obstacle without a material: above any body's, so that the pair takes the body's.
 constexpr double kRigidFriction = 1e30;
 
@@ -192,6 +192,7 @@ struct Body {
   Eigen::Vector3d impulse = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_impulse = Eigen::Vector3d::Zero();
   Wrench contact;  // of the last step
+  Eigen::Vector3d com_before = Eigen::Vector3d::Zero();  // the centre of mass the last step's solver used
 };
 
 // A spring end: a body (its point relative to the centre, turbid's body frame) or a world anchor.
@@ -279,6 +280,7 @@ btRigidBody& BulletWorld::Impl::add_obstacle(std::unique_ptr<btCollisionShape> s
   btRigidBody::btRigidBodyConstructionInfo info(0.0, state, shape.get(), btVector3(0, 0, 0));
   info.m_startWorldTransform = where;
   auto r = std::make_unique<btRigidBody>(info);  // mass 0: static, or kinematic
+  r->setContactProcessingThreshold(kTouchDistance);
   r->setRestitution(material ? material->restitution : 1.0);
   r->setFriction(material ? material->friction : kRigidFriction);
   if (kinematic) {
@@ -293,7 +295,9 @@ btRigidBody& BulletWorld::Impl::add_obstacle(std::unique_ptr<btCollisionShape> s
 
 void BulletWorld::Impl::add_obstacles(const ContactWorld& w) {
   for (const ContactFace& f : w.faces) {
-    // A slab behind the face, as thick as the face is long.
+    // A slab behind the face, 2 dx thick (as thick as the face is long when dx is not known): a
+    // body moves far less than dx in a step, so it cannot tunnel, and a thin wall's slab stays
+    // within the wall's own particle layers instead of standing out on its far side.
     const double l1 = f.edge_1.norm(), l2 = f.edge_2.norm();
     if (!(l1 > 0)) continue;
     const Eigen::Vector3d u1 = f.edge_1 / l1;
@@ -301,10 +305,11 @@ void BulletWorld::Impl::add_obstacles(const ContactWorld& w) {
     Eigen::Matrix3d axes;
     axes << u1, u2, f.normal;
     if (axes.determinant() < 0) axes.col(1) = -axes.col(1);
-    const double half_thick = 0.5 * std::max(l1, l2);
+    const double half_thick = 0.5 * (w.spacing > 0 ? std::min(std::max(l1, l2), 2 * w.spacing) : std::max(l1, l2));
     const Eigen::Vector3d half(0.5 * l1, dims == 2 ? kObstacleHalfDepth2d : 0.5 * l2, half_thick);
-    const Eigen::Vector3d centre = f.origin + 0.5 * f.edge_1 + (dims == 2 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(0.5 * f.edge_2)) -
-                                   half_thick * f.normal;
+    Eigen::Vector3d centre = f.origin + 0.5 * f.edge_1 + (dims == 2 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(0.5 * f.edge_2)) -
+                             half_thick * f.normal;
+    if (dims == 2) centre.z() = 0;
     auto box = std::make_unique<btBoxShape>(to_bt(half));
     box->setMargin(margin_for(2 * std::min(half.x(), half.y())));
     add_obstacle(std::move(box), btTransform(to_bt_matrix(axes), to_bt(centre)), std::nullopt);
@@ -353,7 +358,7 @@ void BulletWorld::Impl::collect_contacts(double dt) {
   auto add = [&](int index, const btVector3& at, const Eigen::Vector3d& J) {
     if (index < 0) return;
     Body& b = *bodies[std::size_t(index)];
-    const Eigen::Vector3d r = from_bt(at) - from_bt(b.rigid->getCenterOfMassPosition());
+    const Eigen::Vector3d r = from_bt(at) - b.com_before;
     b.contact.force += J / dt;
     b.contact.torque += r.cross(J) / dt;
   };
@@ -464,7 +469,11 @@ void BulletWorld::Impl::add_body(const BulletBodySpec& spec) {
       break;
     }
   }
-  if (smallest > 0) b->child->setMargin(std::min(kBulletMargin, 0.1 * smallest));
+  // A box's or cylinder's margin lies inside its extents; a convex hull's lies outside its vertices,
+  // so a hull body would rest a margin above what it touches (5 mm for a 5 cm block with the usual
+  // tenth): its margin is 1e-4 of its smallest extent, which Bullet's double-precision GJK/EPA takes.
+  if (smallest > 0)
+    b->child->setMargin(sh.kind == BulletShape::Kind::hull ? 1e-4 * smallest : std::min(kBulletMargin, 0.1 * smallest));
   b->compound = std::make_unique<btCompoundShape>(false, 1);
   if (sh.kind == BulletShape::Kind::hull) {
     b->compound->addChildShape(btTransform::getIdentity(), b->child.get());
@@ -492,7 +501,10 @@ void BulletWorld::Impl::add_body(const BulletBodySpec& spec) {
   if (!weight_by_bullet) flags |= int(BT_DISABLE_WORLD_GRAVITY);
   r.setFlags(flags);
   if (!weight_by_bullet) r.setGravity(btVector3(0, 0, 0));
+  if (spec.structure < by_structure.size() && by_structure[spec.structure] >= 0)
+    throw std::invalid_argument("structure " + std::to_string(spec.structure) + " is given twice as a bullet body");
   r.setUserIndex(int(bodies.size()));  // contacts find their body by it
+  r.setContactProcessingThreshold(kTouchDistance);
   if (spec.contact) {
     r.setRestitution(spec.contact->restitution);
     r.setFriction(spec.contact->friction);
@@ -503,8 +515,6 @@ void BulletWorld::Impl::add_body(const BulletBodySpec& spec) {
   // (Each takes the world's gravity unless BT_DISABLE_WORLD_GRAVITY.)
 
   if (spec.structure >= by_structure.size()) by_structure.resize(spec.structure + 1, -1);
-  if (by_structure[spec.structure] >= 0)
-    throw std::invalid_argument("structure " + std::to_string(spec.structure) + " is given twice as a bullet body");
   by_structure[spec.structure] = int(bodies.size());
   bodies.push_back(std::move(b));
 }
@@ -613,14 +623,13 @@ BulletWorld::BulletWorld(int dims, const Eigen::Vector3d& gravity, const std::ve
   btContactSolverInfo& info = w.world->getSolverInfo();
   info.m_splitImpulse = 1;
   info.m_splitImpulsePenetrationThreshold = std::numeric_limits<btScalar>::infinity();
-  // Contacts only where objects touch or overlap: Bullet's default also keeps speculative contacts
-  // up to 2% of a shape's size apart and lets a body close such a gap in one step, taking gap / dt
-  // off its rebound speed (a bounce's restitution then depends on where in a step the touch falls).
-  // An absolute threshold of kTouchDistance instead; the overlap a step leaves (at most the approach
-  // speed x dt) is removed by the split impulses.
-  w.dispatcher->setDispatcherFlags(w.dispatcher->getDispatcherFlags() &
-                                   ~int(btCollisionDispatcher::CD_USE_RELATIVE_CONTACT_BREAKING_THRESHOLD));
-  gContactBreakingThreshold = kTouchDistance;
+  // Only contacts where objects touch or overlap reach the solver (each object's contact processing
+  // threshold is 0, set where it is made): Bullet keeps contact points up to a fraction of a shape's
+  // size apart in its manifolds (so a resting face builds up several points over a few steps, which
+  // torsional friction and a steady support need) and by default solves them speculatively, letting
+  // a body close such a gap in one step and taking gap / dt off its rebound speed (a bounce's
+  // restitution then depended on where in a step the touch fell). The overlap a step leaves, at
+  // most the approach speed x dt, is removed by the split impulses.
   gCalculateCombinedRestitutionCallback = &smaller_restitution;
   gCalculateCombinedFrictionCallback = &smaller_friction;
   for (const auto& b : bodies) w.add_body(b);
@@ -649,6 +658,7 @@ void BulletWorld::kick(double duration, const std::vector<Wrench>& loads) {
 void BulletWorld::step(double dt) {
   if (!(dt > 0)) throw std::invalid_argument("a bullet step needs dt > 0");
   for (auto& b : impl_->bodies) {
+    b->com_before = from_bt(b->rigid->getCenterOfMassPosition());
     b->rigid->applyCentralForce(to_bt(Eigen::Vector3d(b->impulse / dt)));
     b->rigid->applyTorque(to_bt(Eigen::Vector3d(b->angular_impulse / dt)));
     b->impulse.setZero();

@@ -27,8 +27,8 @@
 // friction, solved with the step). A body takes part in contacts when its structure has a contact
 // material (`contact:`), as a free body does: it then touches the other bullet bodies with one and
 // the scene's obstacles, the same ContactWorld the DEM contacts use (scene_interactions.hpp): a
-// container face or polyline segment as a slab behind the face (a box as thick as the face is long,
-// so nothing tunnels through it), a solid box as its box, a fixed structure as the spheres of its
+// container face or polyline segment as a slab behind the face (a box 2 dx thick: a body moves far
+// less than dx in a step, so nothing tunnels through it), a solid box as its box, a fixed structure as the spheres of its
 // surface layer (dx/2, as in the DEM contacts; its exact sphere for a sphere or 2D cylinder), a
 // prescribed structure likewise as a kinematic body that follows its path. In 2D
 // every obstacle spans z in [-1, 1] m. Bullet's contacts are rigid: a material's restitution and
@@ -36,7 +36,7 @@
 // stiffness). A pair takes the smaller restitution and the smaller friction of its two sides (the
 // DEM rule; an obstacle without a material takes the body's); Bullet gives no restitution below an
 // approach speed of 0.2 m/s (its m_restitutionVelocityThreshold). Bullet bodies do not touch free
-// (built-in) bodies or prescribed structures. The contact force on a body (its impulses over the
+// (built-in) bodies. The contact force on a body (its impulses over the
 // step / dt) goes to forces.csv as a free body's does.
 //
 // Locks: Bullet's linear and angular factors (world axes), 2D adds z translation and x, y rotation
@@ -167,8 +167,8 @@ class BulletWorld {
   void step(double dt);
 
   // The contact wrench on a body in the last step (its contact and friction impulses / dt, about
-  // the centre of mass, world frame) [N], [N m], and the deepest penetration Bullet left between
-  // any two touching objects at the end of that step [m] (0 when none).
+  // the centre of mass the solver used, world frame) [N], [N m], and the deepest penetration
+  // Bullet's collision detection found in that step, before its correction [m] (0 when none).
   Wrench contact_load(std::size_t structure) const;
   // Prescribed structures among the obstacles are kinematic bodies: move_prescribed puts each where
   // where(structure) says for the next step (Bullet gives it the velocity of that move over the

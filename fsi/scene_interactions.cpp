@@ -39,6 +39,7 @@ ContactWorld contact_world(const Scene& scene, const SurfaceLayers& surface) {
   const int d = scene.dimensions;
   ContactWorld w;
   w.dims = d;
+  w.spacing = scene.particle_spacing;
   int wall_id = 0;
   for (const auto& wall : scene.walls) {
     switch (wall.kind) {

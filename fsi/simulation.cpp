@@ -551,7 +551,7 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
     backend = sph::cuda_device_count(&why) > 0 ? sph::make_cuda_backend() : sph::make_cpu_backend(options.threads);
     // A backend without splitting (or moving bodies) hands the scene to the CPU. Moving bodies on
     // CUDA (sph/backend/cuda) are built but have not yet run on a GPU (CudaBodies.* in
-    // tests/unit/test_cuda_backend.cpp wait for a device): until they have, 'auto' keeps such scenes
+    // tests/unit/test_cuda_bodies.cpp wait for a device): until they have, 'auto' keeps such scenes
     // on the CPU and '--backend cuda' runs them.
     if (!scene_.transitions.empty() && !backend->supports_splitting()) backend = sph::make_cpu_backend(options.threads);
     if ((free_bodies || prescribed) && (!backend->supports_moving_bodies() || backend->name() == "cuda"))

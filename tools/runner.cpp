@@ -380,10 +380,10 @@ std::string describe_scene(const fsi::Scene& scene) {
       os << "    contacts: none (no 'contact' material)\n";
     } else if (st.motion == fsi::StructureSpec::Motion::bullet) {
       os << "    contacts: Bullet's rigid contacts, restitution " << c.restitution << ", friction " << c.friction
-         << " (walls, fixed structures, other bullet bodies)\n";
+         << " (walls, fixed and prescribed structures, other bullet bodies)\n";
     } else {
       os << "    contacts: DEM Hertz, E " << c.youngs_modulus << " Pa, Poisson " << c.poisson_ratio << ", restitution "
-         << c.restitution << ", friction " << c.friction << " (walls, fixed structures, other free bodies)\n";
+         << c.restitution << ", friction " << c.friction << " (walls, fixed and prescribed structures, other free bodies)\n";
     }
   }
   {
