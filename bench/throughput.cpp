@@ -75,8 +75,20 @@ void DamBreakObstacle3D(benchmark::State& state) {
   state.SetLabel(sim.backend_name() + ", " + std::to_string(sim.threads()) + " threads");
 }
 
+// The same case scaled for the GPU (issue #3): 4500, 2800 and 1750 um give about 1.0, 4.0 and 15.9
+// million particles. Skipped on the CPU backend.
+void DamBreakObstacle3DLarge(benchmark::State& state) {
+  const char* backend = std::getenv("TURBID_BENCH_BACKEND");
+  if (!backend || std::string(backend) != "cuda") {
+    state.SkipWithError("GPU sizes: set TURBID_BENCH_BACKEND=cuda");
+    return;
+  }
+  DamBreakObstacle3D(state);
+}
+
 }  // namespace
 
 BENCHMARK(DamBreakObstacle3D)->Arg(8500)->Unit(benchmark::kMillisecond)->Iterations(20)->UseRealTime();
+BENCHMARK(DamBreakObstacle3DLarge)->Arg(4500)->Arg(2800)->Arg(1750)->Unit(benchmark::kMillisecond)->Iterations(20)->UseRealTime();
 
 BENCHMARK_MAIN();
