@@ -100,11 +100,6 @@ struct ContactWorld {
   std::vector<ContactFace> faces;         // grouped by wall, walls in scene order
   std::vector<ContactBox> boxes;
   std::vector<FixedContactShape> fixed;   // one per fixed or prescribed structure (any order, kept)
-  bool has_prescribed() const {
-    for (const auto& f : fixed)
-      if (f.prescribed >= 0) return true;
-    return false;
-  }
 };
 
 // Contact key: body, its sphere, obstacle kind (0 face, 1 box, 2 fixed structure, 3 body), obstacle
@@ -119,9 +114,7 @@ class BodyContacts {
 
   bool any() const { return active_count_ > 0; }
   const BodyContactShape& shape(std::size_t k) const { return shapes_[k]; }
-  const ContactWorld& world() const { return world_; }
-
-  // Puts the prescribed obstacle world().fixed[j] where `m` says, for the evaluations that follow
+  // Puts the prescribed obstacle fixed[j] of the ContactWorld where `m` says, for the evaluations that follow
   // (its spheres x_ref + R (c0 - x_ref0), the velocity at a contact point v + w x (p - x_ref)).
   void move_obstacle(std::size_t j, const ObstacleMotion& m);
   // Moves every prescribed obstacle to where(structure).

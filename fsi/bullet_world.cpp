@@ -694,7 +694,6 @@ void BulletWorld::place_prescribed(const std::function<ObstacleMotion(std::size_
   }
 }
 double BulletWorld::last_max_penetration() const { return impl_->max_penetration; }
-std::size_t BulletWorld::obstacle_count() const { return impl_->obstacles.size(); }
 
 BulletBodyState BulletWorld::state(std::size_t structure) const { return impl_->state(impl_->body_of(structure)); }
 
@@ -757,7 +756,6 @@ Wrench BulletWorld::contact_load(std::size_t) const { throw std::runtime_error(k
 void BulletWorld::move_prescribed(const std::function<ObstacleMotion(std::size_t)>&) {}
 void BulletWorld::place_prescribed(const std::function<ObstacleMotion(std::size_t)>&) {}
 double BulletWorld::last_max_penetration() const { return 0; }
-std::size_t BulletWorld::obstacle_count() const { return 0; }
 BulletWorld::~BulletWorld() = default;
 std::size_t BulletWorld::body_count() const { return 0; }
 int BulletWorld::body_of(std::size_t) const { return -1; }

@@ -177,7 +177,6 @@ class BulletWorld {
   void move_prescribed(const std::function<ObstacleMotion(std::size_t structure)>& where);
   void place_prescribed(const std::function<ObstacleMotion(std::size_t structure)>& where);
   double last_max_penetration() const;
-  std::size_t obstacle_count() const;
 
   BulletBodyState state(std::size_t structure) const;
   // Puts a body in this state (velocities projected on its free axes) and clears its impulse.
