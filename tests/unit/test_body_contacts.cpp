@@ -459,6 +459,34 @@ TEST_P(Contacts, BoxSlidesAcrossTheJointOfTwoCollinearSegments) {
   EXPECT_LT(worst_vy, 1e-2);
 }
 
+// Interpenetration seen on the particles of bodies 0 and 1 in a closed tank [0, width] x [0, height]
+// (2D): the smallest distance between a particle of one body and one of the other (touching
+// surfaces put their surface layers dx apart), and the deepest a body particle reaches past dx/2
+// from a tank face (surface particles lie dx/2 inside the surface).
+struct ParticleGaps {
+  double closest = 1e9;  // [m]
+  double wall = -1e9;    // [m], dx/2 minus the smallest distance to a face
+};
+ParticleGaps particle_gaps(const fsi::Simulation& sim, double dx, double width, double height) {
+  const auto& st = sim.store();
+  const auto& ids = sim.fields();
+  const auto* x = st.data<float>(ids.position);
+  const auto* kind = st.data<std::uint8_t>(ids.kind);
+  const auto* body = st.data<std::uint8_t>(ids.body);
+  std::vector<std::size_t> p0, p1;
+  ParticleGaps g;
+  for (std::size_t i = 0; i < st.size(); ++i) {
+    if (kind[i] != 2) continue;
+    (body[i] == 0 ? p0 : p1).push_back(i);
+    const double d = std::min({double(x[2 * i]), double(x[2 * i + 1]), width - x[2 * i], height - x[2 * i + 1]});
+    g.wall = std::max(g.wall, 0.5 * dx - d);
+  }
+  for (std::size_t i : p0)
+    for (std::size_t j : p1)
+      g.closest = std::min(g.closest, std::hypot(double(x[2 * i] - x[2 * j]), double(x[2 * i + 1] - x[2 * j + 1])));
+  return g;
+}
+
 TEST_P(Contacts, BodiesDrivenIntoEachOtherAndACornerDoNotInterpenetrate) {
   const double dx = 0.01;
   // Gravity tilted towards -x: the lower box is pressed into the corner, the upper one falls on it
@@ -472,8 +500,6 @@ TEST_P(Contacts, BodiesDrivenIntoEachOtherAndACornerDoNotInterpenetrate) {
 )";
   fsi::Simulation sim(scene_of(moved(yaml)), cpu());
   sim.start();
-  const auto& st = sim.store();
-  const auto& ids = sim.fields();
   double worst_pair = -1e9, worst_wall = -1e9, worst_sphere = 0;
   int most_substeps = 0;
   int touched_pair = 0;
@@ -483,21 +509,9 @@ TEST_P(Contacts, BodiesDrivenIntoEachOtherAndACornerDoNotInterpenetrate) {
     const auto* bullet = sim.bodies()->bullet();
     worst_sphere = std::max(worst_sphere, bullet ? bullet->last_max_penetration() : sim.bodies()->last_max_overlap());
     most_substeps = std::max(most_substeps, sim.bodies()->last_substeps());
-    const auto* x = st.data<float>(ids.position);
-    const auto* kind = st.data<std::uint8_t>(ids.kind);
-    const auto* body = st.data<std::uint8_t>(ids.body);
-    std::vector<std::size_t> p0, p1;
-    for (std::size_t i = 0; i < st.size(); ++i) {
-      if (kind[i] != 2) continue;
-      (body[i] == 0 ? p0 : p1).push_back(i);
-      // Surface particles lie dx/2 inside the surface: to the walls x = 0, y = 0 (and x, y = 0.6).
-      const double d = std::min({double(x[2 * i]), double(x[2 * i + 1]), 0.6 - x[2 * i], 0.6 - x[2 * i + 1]});
-      worst_wall = std::max(worst_wall, 0.5 * dx - d);
-    }
-    double closest = 1e9;
-    for (std::size_t i : p0)
-      for (std::size_t j : p1)
-        closest = std::min(closest, std::hypot(double(x[2 * i] - x[2 * j]), double(x[2 * i + 1] - x[2 * j + 1])));
+    const ParticleGaps g = particle_gaps(sim, dx, 0.6, 0.6);
+    const double closest = g.closest;
+    worst_wall = std::max(worst_wall, g.wall);
     worst_pair = std::max(worst_pair, dx - closest);
     if (closest < 1.01 * dx) ++touched_pair;  // touching, within 1% of dx (rigid Bullet contacts do not overlap)
   }
@@ -540,8 +554,6 @@ structures:
 )";
   fsi::Simulation sim(scene_of(moved(yaml)), cpu());
   sim.start();
-  const auto& st = sim.store();
-  const auto& ids = sim.fields();
   double worst_pair = -1e9, worst_wall = -1e9;
   int touched_pair = 0, touched_wall = 0, most_substeps = 0;
   const fsi::RigidBody& a = sim.bodies()->body(0);
@@ -550,23 +562,10 @@ structures:
   while (sim.time() < end) {
     sim.step();
     most_substeps = std::max(most_substeps, sim.bodies()->last_substeps());
-    const auto* x = st.data<float>(ids.position);
-    const auto* kind = st.data<std::uint8_t>(ids.kind);
-    const auto* body = st.data<std::uint8_t>(ids.body);
-    std::vector<std::size_t> p0, p1;
-    double wall = -1e9;
-    for (std::size_t i = 0; i < st.size(); ++i) {
-      if (kind[i] != 2) continue;
-      (body[i] == 0 ? p0 : p1).push_back(i);
-      const double d = std::min({double(x[2 * i]), double(x[2 * i + 1]), 0.8 - x[2 * i], 0.5 - x[2 * i + 1]});
-      wall = std::max(wall, 0.5 * dx - d);
-    }
-    double closest = 1e9;
-    for (std::size_t i : p0)
-      for (std::size_t j : p1)
-        closest = std::min(closest, std::hypot(double(x[2 * i] - x[2 * j]), double(x[2 * i + 1] - x[2 * j + 1])));
+    const ParticleGaps g = particle_gaps(sim, dx, 0.8, 0.5);
+    const double closest = g.closest;
     worst_pair = std::max(worst_pair, dx - closest);
-    worst_wall = std::max(worst_wall, wall);
+    worst_wall = std::max(worst_wall, g.wall);
     if (closest < dx) ++touched_pair;
     if (b.position().x() > 0.8 - 0.03 - 0.5 * dx) ++touched_wall;
   }
