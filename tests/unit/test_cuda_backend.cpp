@@ -71,6 +71,9 @@ struct Case {
   KernelKind kernel;
   Diffusion diffusion;
   Viscosity viscosity;
+  // Water beside a Herschel-Bulkley-Papanastasiou debris of 1950 kg/m^3 (the materials issue):
+  // rheology pass, harmonic-mean viscosity, per-material EOS and the ghost-density correction.
+  bool two_materials = false;
 };
 
 // Names the case in test output (instead of its bytes).
@@ -78,6 +81,7 @@ void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
 
 constexpr double kDx = 0.01;    // particle spacing [m]
 constexpr double kRho0 = 1000;  // [kg/m^3]
+constexpr double kDebrisRho = 1950;  // the debris of the two-material case [kg/m^3]
 
 PhysicsParams make_params(const Case& c) {
   PhysicsParams p;
@@ -96,12 +100,25 @@ PhysicsParams make_params(const Case& c) {
   p.materials[0].eos = TaitEos::make(kRho0, 20.0, 7.0, 0.0);
   p.materials[0].sound_speed = Real(20);
   p.materials[0].dynamic_viscosity = Real(1e-3);
+  p.materials[0].rheology.consistency = Real(1e-3);
+  if (c.two_materials) {
+    p.material_count = 2;
+    p.rheology = true;
+    p.interface_correction = true;
+    MaterialParams& debris = p.materials[1];
+    debris.eos = TaitEos::make(kDebrisRho, 20.0, 7.0, 0.0);
+    debris.sound_speed = Real(20);
+    debris.rheology = Rheology{Real(50), Real(0.5), Real(0.8), Real(100), Real(5)};  // tau_y, K, n, m, cap
+    debris.dynamic_viscosity = debris.rheology.max_viscosity;
+    debris.non_newtonian = true;
+  }
   return p;
 }
 
 // A fluid block over three wall layers, jittered, with varied density and velocity, stored in a
 // shuffled order, plus one particle outside the domain, one with a NaN position and one just past
-// the domain's upper x face (inside the whole-cell grid, still removed).
+// the domain's upper x face (inside the whole-cell grid, still removed). With two materials the
+// fluid beyond x = nx dx / 2 is debris (material 1, its rest density and mass).
 template <int D>
 FieldIds build_block(ParticleStore& s, const PhysicsParams& p, Domain& domain) {
   const FieldIds ids = register_fields(s, p);
@@ -149,10 +166,12 @@ FieldIds build_block(ParticleStore& s, const PhysicsParams& p, Domain& domain) {
   for (std::size_t n = 0; n < parts.size(); ++n) {
     s.data<Vec<D>>(ids.position)[n] = parts[n].x;
     s.data<Vec<D>>(ids.velocity)[n] = parts[n].v;
-    s.data<Real>(ids.density)[n] = parts[n].rho;
-    s.data<Real>(ids.mass)[n] = Real(kRho0) * vol;
+    const bool debris = p.material_count > 1 && parts[n].kind == std::uint8_t(Kind::fluid) && parts[n].x[0] > Real(nx * kDx / 2);
+    const Real ratio = debris ? Real(kDebrisRho / kRho0) : Real(1);
+    s.data<Real>(ids.density)[n] = parts[n].rho * ratio;
+    s.data<Real>(ids.mass)[n] = Real(kRho0) * vol * ratio;
     s.data<Real>(ids.smoothing_length)[n] = p.smoothing_length;
-    s.data<std::uint8_t>(ids.material)[n] = 0;
+    s.data<std::uint8_t>(ids.material)[n] = debris ? 1 : 0;
     s.data<std::uint8_t>(ids.kind)[n] = parts[n].kind;
     s.data<std::uint32_t>(ids.id)[n] = std::uint32_t(n);
   }
@@ -228,6 +247,10 @@ void run_parity(const Case& c) {
   const auto acc = by_id(cpu_store, gpu_store, ids, ids.acceleration);
   EXPECT_LT(relative_difference(cpu_store.data<float>(ids.density_rate), rate.data(), n), 1e-5);
   EXPECT_LT(relative_difference(cpu_store.data<float>(ids.acceleration), acc.data(), n * D), 1e-5);
+  if (ids.effective_viscosity >= 0) {
+    const auto mu = by_id(cpu_store, gpu_store, ids, ids.effective_viscosity);
+    EXPECT_LT(relative_difference(cpu_store.data<float>(ids.effective_viscosity), mu.data(), n), 1e-5);
+  }
 
   const StepStats s_cpu = cpu->stats(), s_gpu = gpu->stats();
   EXPECT_NEAR(s_gpu.max_speed, s_cpu.max_speed, 1e-6 * s_cpu.max_speed);  // same velocities, exact max
@@ -286,7 +309,9 @@ INSTANTIATE_TEST_SUITE_P(
     CudaBackend, CudaParity,
     ::testing::Values(Case{"wendland_fourtakas_2d", 2, KernelKind::wendland_c2, Diffusion::fourtakas, Viscosity::artificial},
                       Case{"cubic_antuono_laminar_2d", 2, KernelKind::cubic_spline, Diffusion::antuono, Viscosity::laminar},
-                      Case{"wendland_molteni_3d", 3, KernelKind::wendland_c2, Diffusion::molteni, Viscosity::artificial}),
+                      Case{"wendland_molteni_3d", 3, KernelKind::wendland_c2, Diffusion::molteni, Viscosity::artificial},
+                      Case{"water_and_hbp_debris_2d", 2, KernelKind::wendland_c2, Diffusion::fourtakas, Viscosity::laminar, true},
+                      Case{"water_and_hbp_debris_3d", 3, KernelKind::wendland_c2, Diffusion::fourtakas, Viscosity::laminar, true}),
     [](const ::testing::TestParamInfo<Case>& info) { return std::string(info.param.name); });
 
 // ---- splitting on both backends (GPU only) -----------------------------------------------------
