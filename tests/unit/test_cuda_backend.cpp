@@ -81,7 +81,7 @@ void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
 
 constexpr double kDx = 0.01;    // particle spacing [m]
 constexpr double kRho0 = 1000;  // [kg/m^3]
-constexpr double kDebrisRho = 1950;  // the debris of the two-material case [kg/m^3]
+constexpr double kSlideRho = 1950.0;  // debris (and turbidity) reference density [kg/m^3]
 
 PhysicsParams make_params(const Case& c) {
   PhysicsParams p;
@@ -106,7 +106,7 @@ PhysicsParams make_params(const Case& c) {
     p.rheology = true;
     p.interface_correction = true;
     MaterialParams& debris = p.materials[1];
-    debris.eos = TaitEos::make(kDebrisRho, 20.0, 7.0, 0.0);
+    debris.eos = TaitEos::make(kSlideRho, 20.0, 7.0, 0.0);
     debris.sound_speed = Real(20);
     debris.rheology = Rheology{Real(50), Real(0.5), Real(0.8), Real(100), Real(5)};  // tau_y, K, n, m, cap
     debris.dynamic_viscosity = debris.rheology.max_viscosity;
@@ -167,7 +167,7 @@ FieldIds build_block(ParticleStore& s, const PhysicsParams& p, Domain& domain) {
     s.data<Vec<D>>(ids.position)[n] = parts[n].x;
     s.data<Vec<D>>(ids.velocity)[n] = parts[n].v;
     const bool debris = p.material_count > 1 && parts[n].kind == std::uint8_t(Kind::fluid) && parts[n].x[0] > Real(nx * kDx / 2);
-    const Real ratio = debris ? Real(kDebrisRho / kRho0) : Real(1);
+    const Real ratio = debris ? Real(kSlideRho / kRho0) : Real(1);
     s.data<Real>(ids.density)[n] = parts[n].rho * ratio;
     s.data<Real>(ids.mass)[n] = Real(kRho0) * vol * ratio;
     s.data<Real>(ids.smoothing_length)[n] = p.smoothing_length;
@@ -315,8 +315,6 @@ INSTANTIATE_TEST_SUITE_P(
     [](const ::testing::TestParamInfo<Case>& info) { return std::string(info.param.name); });
 
 // ---- splitting on both backends (GPU only) -----------------------------------------------------
-
-constexpr double kSlideRho = 1950.0;  // debris and turbidity reference density [kg/m^3]
 
 // As in test_splitting.cpp: variable h (a scene with transitions runs that path), rheology on so
 // the shear stress the criterion reads is registered, water (0), debris (1) and turbidity (2).
