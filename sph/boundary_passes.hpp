@@ -48,16 +48,23 @@ TURBID_HD inline Real solve_small(Real (&A)[N][N], Real (&b)[N], Real (&x)[N]) {
 }
 
 // First-order corrected SPH interpolation at a ghost node x_g over the fluid (physics.md C5):
-//   [ sum W V        sum x_jg^T W V        ] [ rho_g      ]   [ sum m W      ]
-//   [ sum grad W V   sum grad W (x) x_jg V ] [ grad rho_g ] = [ sum m grad W ]
+//   [ sum W V        sum x_jg^T W V        ] [ rho_g      ]   [ sum rho*_j W V      ]
+//   [ sum grad W V   sum grad W (x) x_jg V ] [ grad rho_g ] = [ sum rho*_j grad W V ]
 // `density` gets rho_g + (x_b - x_g) . grad rho_g with offset = x_g - x_b; where |det| < 1e-3
-// (too few neighbours on one side) the Shepard value sum m W / sum V W. `velocity` gets the
-// Shepard-interpolated fluid velocity at x_g. Returns the fluid's share of the kernel support at x_g,
-// sum_fluid V_j W_gj (about 1 inside the fluid, 0 when no fluid is in reach: nothing set then);
-// `boundary_share` gets the same sum over the other particles (walls, structures, buffers).
+// (too few neighbours on one side) the Shepard value sum rho* W V / sum V W. rho*_j is the density
+// that the boundary particle's equation of state `eos` (material `ref`) gives at j's pressure: rho_j
+// itself for a neighbour of material `ref` (m_j W, bit for bit as with one material), and
+// eos.density(p_j(rho_j)) for another. What is extrapolated is thus the fluid's pressure, which is
+// continuous across an interface; the relative density is not (a wall beside debris of 1950 kg/m^3
+// read as water would be at 1.95 rho0, p = B (1.95^7 - 1)).
+// `velocity` gets the Shepard-interpolated fluid velocity at x_g. Returns the fluid's share of the
+// kernel support at x_g, sum_fluid V_j W_gj (about 1 inside the fluid, 0 when no fluid is in reach:
+// nothing set then); `boundary_share` gets the same sum over the other particles (walls, structures,
+// buffers) with their rest volumes: their densities are what the calling pass writes, so reading
+// them would race with it (and depend on the thread schedule).
 template <int D, class K, bool UniformH>
 TURBID_HD inline Real ghost_interpolation(const ParticleView<D>& P, const GridView<D>& G, const PhysicsParams& prm,
-                                          const Vec<D>& xg, const Vec<D>& offset, Real h_b, Real& density,
+                                          const Vec<D>& xg, const Vec<D>& offset, Real h_b, int ref, Real& density,
                                           Vec<D>& velocity, Real& boundary_share) {
   boundary_share = 0;
   int c[D] = {};
@@ -67,6 +74,7 @@ TURBID_HD inline Real ghost_interpolation(const ParticleView<D>& P, const GridVi
   Real A[N][N] = {};
   Real rhs[N] = {};
   Vec<D> vsum = Vec<D>::zero();
+  const TaitEos& eos = prm.materials[ref].eos;
   G.for_each_neighbour_range(c, [&](std::uint32_t j0, std::uint32_t j1, const Vec<D>& image) {
     const Vec<D> xo = xg - image;
     for (std::uint32_t j = j0; j < j1; ++j) {
@@ -79,12 +87,15 @@ TURBID_HD inline Real ghost_interpolation(const ParticleView<D>& P, const GridVi
       const Real rr = std::sqrt(r2);
       const Real W = K::w(rr, h);
       if (!fluid) {
-        boundary_share += W * P.mass[j] / P.density[j];
+        // Rest volume: walls and structures are in the wall material's units, buffers in their own.
+        const int mb = P.kind[j] == std::uint8_t(Kind::buffer) ? int(P.material[j]) : prm.wall_material;
+        boundary_share += W * P.mass[j] / prm.materials[mb].eos.rest_density;
         continue;
       }
       const Real F = K::f_inv(rr, Real(1) / h);  // grad_g W_gj = F r
-      const Real m = P.mass[j];
-      const Real V = m / P.density[j];
+      const Real V = P.mass[j] / P.density[j];
+      const int mat = P.material[j];
+      const Real m = mat == ref ? P.mass[j] : V * eos.density_at(prm.materials[mat].eos.pressure(P.density[j]));
       A[0][0] += W * V;
       rhs[0] += m * W;
       for (int a = 0; a < D; ++a) {
@@ -143,7 +154,8 @@ struct MdbcPass {
     Vec<D> v_ghost = Vec<D>::zero();
     if (norm2(n) > Real(0)) {
       Real walls = 0;
-      const Real fluid = ghost_interpolation<D, K, UniformH>(P, G, prm, P.position[b] + n, n, h_b, rho, v_ghost, walls);
+      const Real fluid = ghost_interpolation<D, K, UniformH>(P, G, prm, P.position[b] + n, n, h_b, prm.wall_material,
+                                                             rho, v_ghost, walls);
       if (fluid < prm.mdbc_wet_share * (Real(1) - walls)) rho = rho0;
     }
     const Real rho_min = prm.materials[prm.wall_material].eos.no_tension_density();
@@ -185,7 +197,8 @@ struct BufferPass {
   TURBID_HD void operator()(std::uint32_t b) const {
     if (P.kind[b] != std::uint8_t(Kind::buffer)) return;
     const BufferZone& z = prm.zones[P.zone[b]];
-    const Real rho0 = prm.materials[z.material].eos.rest_density;
+    // The particle's own material: an inlet's, or that of the fluid particle that entered an outlet.
+    const Real rho0 = prm.materials[P.material[b]].eos.rest_density;
     const Vec<D> xb = P.position[b];
     Vec<D> n = Vec<D>::zero();
     n[z.axis] = Real(2) * (z.plane - xb[z.axis]);
@@ -193,7 +206,8 @@ struct BufferPass {
     Real rho = rho0;
     Vec<D> v_ghost = P.velocity[b];
     Real walls = 0;
-    const bool found = ghost_interpolation<D, K, UniformH>(P, G, prm, xb + n, n, h_b, rho, v_ghost, walls) > Real(0);
+    const bool found =
+        ghost_interpolation<D, K, UniformH>(P, G, prm, xb + n, n, h_b, P.material[b], rho, v_ghost, walls) > Real(0);
     if (z.type == ZoneType::inlet) {
       P.density[b] = found ? rho : rho0;
       P.velocity[b] = zone_velocity<D>(z, xb);

@@ -27,6 +27,12 @@ struct TaitEos {
   TURBID_HD Real density(Real p) const {
     return rest_density * std::pow((p - background_pressure) / stiffness + Real(1), Real(1) / gamma);
   }
+  // density(p), for any p: a pressure below -B + p_b (more tension than the equation of state can
+  // describe) gives density 0 instead of the NaN of a negative base.
+  TURBID_HD Real density_at(Real p) const {
+    const Real base = (p - background_pressure) / stiffness + Real(1);
+    return base > Real(0) ? rest_density * std::pow(base, Real(1) / gamma) : Real(0);
+  }
   // Density at zero absolute pressure, the lowest a wall may take (walls carry no tension: a wall
   // that pulled fluid towards it would let it through, and a free surface over a wall would stick).
   // rho0 without background pressure; below rho0 with one, so that a wall under suction (behind a

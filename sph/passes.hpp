@@ -161,13 +161,16 @@ TURBID_HD TURBID_INLINE void for_each_neighbour(const ParticleView<D>& P, const 
   if (out) L.count[i] = n;
 }
 
-// Pressure from density with each material's equation of state (walls use wall_material's).
+// Pressure from density with each material's equation of state: fluid and buffer particles their
+// own material's, walls and structures wall_material's (with mDBC their density is that of
+// wall_material at the fluid's extrapolated pressure, see ghost_interpolation).
 template <int D>
 struct PressurePass {
   ParticleView<D> P;
   PhysicsParams prm;
   TURBID_HD void operator()(std::uint32_t i) const {
-    const int m = P.kind[i] == std::uint8_t(Kind::fluid) ? P.material[i] : prm.wall_material;
+    const bool own = P.kind[i] == std::uint8_t(Kind::fluid) || P.kind[i] == std::uint8_t(Kind::buffer);
+    const int m = own ? P.material[i] : prm.wall_material;
     P.pressure[i] = prm.materials[m].eos.pressure(P.density[i]);
   }
 };

@@ -453,7 +453,9 @@ class CpuBackend final : public Backend {
     for (int k = 0; k < D; ++k)
       if (!std::isfinite(P.position[i][k]) || !std::isfinite(P.velocity[i][k]) || !std::isfinite(P.acceleration[i][k]))
         return false;
-    const int m = P.kind[i] == std::uint8_t(Kind::fluid) ? P.material[i] : params_.wall_material;
+    // Walls and structures hold density in the wall material's units, buffers in their own.
+    const bool own = P.kind[i] == std::uint8_t(Kind::fluid) || P.kind[i] == std::uint8_t(Kind::buffer);
+    const int m = own ? P.material[i] : params_.wall_material;
     const double ratio = double(P.density[i]) / params_.materials[m].eos.rest_density - 1.0;
     return std::isfinite(ratio) && std::abs(ratio) <= limit;
   }

@@ -153,7 +153,9 @@ struct HealthPass {
   __device__ bool healthy(std::uint32_t i) const {
     for (int k = 0; k < D; ++k)
       if (!isfinite(P.position[i][k]) || !isfinite(P.velocity[i][k]) || !isfinite(P.acceleration[i][k])) return false;
-    const int m = P.kind[i] == std::uint8_t(Kind::fluid) ? P.material[i] : prm.wall_material;
+    // Walls and structures hold density in the wall material's units, buffers in their own.
+    const bool own = P.kind[i] == std::uint8_t(Kind::fluid) || P.kind[i] == std::uint8_t(Kind::buffer);
+    const int m = own ? P.material[i] : prm.wall_material;
     const double ratio = double(P.density[i]) / prm.materials[m].eos.rest_density - 1.0;
     return isfinite(ratio) && fabs(ratio) <= limit;
   }
