@@ -22,6 +22,10 @@ struct SourceLocation {
 
 enum class DiffusionKind { none, molteni, antuono, fourtakas };
 enum class ViscosityKind { artificial, laminar };
+// How the laminar viscous terms of non-Newtonian materials are integrated: implicitly where the
+// material's largest viscosity would put the explicit viscous limit below the acoustic one (auto),
+// or always one way (docs/choices.md).
+enum class ViscousIntegration { automatic, explicit_, implicit };
 enum class BoundaryKind { dbc, mdbc };  // wall treatment; see docs/choices.md
 
 // A material's rheology (physics.md C8): newtonian (viscosity), bingham (yield_stress and the
@@ -262,6 +266,7 @@ struct NumericsSpec {
   double diffusion_delta = 0.1;            // delta of the density diffusion term [-]
   ViscosityKind viscosity = ViscosityKind::artificial;
   double artificial_viscosity = 0.01;      // Monaghan alpha [-]
+  ViscousIntegration viscous_integration = ViscousIntegration::automatic;
   double cfl = 0.2;                        // Courant number for the acoustic and force limits [-]
   double viscous_dt_factor = 0.125;        // dt <= factor h^2 / nu_max (Morris et al. 1997)
   double min_time_step = 1.0e-9;           // a smaller dt stops the run as collapsed [s]

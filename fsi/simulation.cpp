@@ -394,13 +394,33 @@ int wall_layers(const Scene& scene, const WallSpec& wall) {
   return std::max(1, int(std::ceil(2.0 * scene.smoothing_ratio - 1e-9)));
 }
 
-// The cap on a non-Newtonian material's mu_eff: as given, or the viscosity whose viscous time-step
-// limit f h^2 rho0 / mu equals the acoustic one CFL h / c0, so that the (nearly rigid) unyielded
-// regions, where HBP's mu_eff tends to m tau_y, do not make dt collapse (docs/choices.md).
-static double max_viscosity(const Scene& scene, const MaterialSpec& m, double sound_speed) {
-  if (m.max_viscosity > 0) return m.max_viscosity;
-  const double h = scene.smoothing_ratio * scene.particle_spacing;
-  return scene.numerics.viscous_dt_factor * h * m.density * sound_speed / scene.numerics.cfl;
+// "file:line:col: error: material 'name': " for messages about a material.
+static std::string material_error(const MaterialSpec& m) {
+  std::ostringstream os;
+  os << m.where.file << ":" << m.where.line << ":" << m.where.column << ": error: material '" << m.name << "': ";
+  return os.str();
+}
+
+// Whether a non-Newtonian material's laminar viscous terms are integrated implicitly: as the scene
+// says, or (auto) where its largest viscosity mu_max (sph::Rheology::bound, a property of the
+// material alone) would put the explicit viscous limit f h^2 rho0 / mu_max below the acoustic one
+// CFL h / c0 at the lattice's h (docs/choices.md).
+static bool implicit_viscosity(const Scene& scene, const MaterialSpec& ms, const sph::Rheology& r, double c0, double h) {
+  const double bound = r.bound();
+  switch (scene.numerics.viscous_integration) {
+    case ViscousIntegration::implicit: return true;
+    case ViscousIntegration::explicit_:
+      if (!std::isfinite(bound))
+        throw std::invalid_argument(material_error(ms) +
+                                    "its viscosity has no upper bound (a power law without 'max_viscosity'), which "
+                                    "explicit viscous integration needs; state 'max_viscosity' or use 'integration: implicit'");
+      return false;
+    case ViscousIntegration::automatic: break;
+  }
+  if (!std::isfinite(bound)) return true;
+  const double viscous = scene.numerics.viscous_dt_factor * h * h * ms.density / bound;
+  const double acoustic = scene.numerics.cfl * h / c0;
+  return viscous < acoustic;
 }
 
 sph::PhysicsParams physics_params(const Scene& scene) {
@@ -446,9 +466,20 @@ sph::PhysicsParams physics_params(const Scene& scene) {
       r.consistency = sph::Real(ms.model == "bingham" ? ms.viscosity : ms.consistency);
       r.flow_index = sph::Real(ms.model == "bingham" ? 1.0 : ms.flow_index);
       r.regularisation = sph::Real(ms.papanastasiou_exponent);
-      r.max_viscosity = sph::Real(max_viscosity(scene, ms, c0));
-      // The viscous time-step limit and the boundary terms see the largest mu_eff possible.
-      p.materials[m].dynamic_viscosity = r.max_viscosity;
+      // The material as stated: Papanastasiou's exponent, and a cap only where the scene gives one.
+      r.max_viscosity = sph::Real(ms.max_viscosity > 0 ? ms.max_viscosity : 0.0);
+      if (r.flow_index < 1 && !(r.regularisation > 0) && !(r.max_viscosity > 0))
+        throw std::invalid_argument(material_error(ms) +
+                                    "a shear-thinning power law without a yield stress has no viscosity at rest; "
+                                    "state 'max_viscosity' [Pa s]");
+      const bool implicit = scene.numerics.viscosity == ViscosityKind::laminar &&
+                            implicit_viscosity(scene, ms, r, c0, scene.smoothing_ratio * scene.particle_spacing);
+      // The explicit viscous time-step limit sees the largest mu_eff possible; an implicit
+      // material sets no viscous limit.
+      const double bound = r.bound();
+      p.materials[m].dynamic_viscosity = sph::Real(std::isfinite(bound) ? bound : double(r.consistency));
+      p.materials[m].implicit_viscosity = implicit;
+      p.implicit_viscosity = p.implicit_viscosity || implicit;
       p.materials[m].non_newtonian = true;
       p.rheology = true;
     }
@@ -554,6 +585,8 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
     // tests/unit/test_cuda_bodies.cpp wait for a device): until they have, 'auto' keeps such scenes
     // on the CPU and '--backend cuda' runs them.
     if (!scene_.transitions.empty() && !backend->supports_splitting()) backend = sph::make_cpu_backend(options.threads);
+    if (params_.implicit_viscosity && !backend->supports_implicit_viscosity())
+      backend = sph::make_cpu_backend(options.threads);
     if ((free_bodies || prescribed) && (!backend->supports_moving_bodies() || backend->name() == "cuda"))
       backend = sph::make_cpu_backend(options.threads);
   } else {
@@ -562,6 +595,10 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
   if (!scene_.transitions.empty() && !backend->supports_splitting())
     throw std::invalid_argument("the scene has transitions (particle splitting), which the " + backend->name() +
                                 " backend does not run yet; use --backend cpu (or auto)");
+  if (params_.implicit_viscosity && !backend->supports_implicit_viscosity())
+    throw std::invalid_argument("the scene integrates a material's viscosity implicitly, which the " + backend->name() +
+                                " backend does not run yet; use --backend cpu (or auto), or 'integration: explicit' "
+                                "with a stated 'max_viscosity'");
   if (free_bodies && !backend->supports_moving_bodies())
     throw std::invalid_argument("the scene has free structures (motion: free or bullet), which the " + backend->name() +
                                 " backend does not run yet; use --backend cpu (or auto)");

@@ -112,6 +112,7 @@ class Simulation {
   // Splitting since the start (transitions): splits, daughters, refused splits.
   const sph::SplitCounts& split_totals() const { return solver_->split_totals(); }
   double split_seconds() const { return solver_->split_seconds(); }  // [s], this process
+  const sph::Solver& solver() const { return *solver_; }
   double step_seconds() const { return solver_->step_seconds(); }    // [s], this process, with transitions
   void restore_split_totals(const sph::SplitCounts& c) { solver_->restore_split_totals(c); }
   double wall_seconds() const { return wall_seconds_; }

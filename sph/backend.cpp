@@ -13,6 +13,10 @@ std::size_t Backend::relax_split(const SplitParams&) {
   throw std::logic_error("the relaxation after a split is not implemented on the " + name() + " backend yet");
 }
 
+ViscousSolve Backend::solve_viscosity(double, double) {
+  throw std::runtime_error("implicit viscosity is not implemented on the " + name() + " backend yet; use --backend cpu");
+}
+
 void Backend::place_bodies(const std::vector<BodyPlacement>&, bool) {
   throw std::runtime_error("moving structures (motion: free) are not implemented on the " + name() +
                            " backend yet; use --backend cpu");

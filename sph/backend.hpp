@@ -26,6 +26,12 @@ struct StepStats {
   double max_acceleration = 0;  // largest fluid acceleration [m/s^2]
 };
 
+struct ViscousSolve {
+  int iterations = 0;
+  bool converged = true;
+  double residual = 0;  // final relative residual |b - A x|_m / |b|_m
+};
+
 struct HealthIssue {
   std::size_t index = 0;  // position in the store
   std::uint32_t id = 0;   // particle id (stable across sorts)
@@ -75,6 +81,13 @@ class Backend {
   // then rules.relax_iterations Jacobi steps); needs the neighbours updated after the split.
   // Returns the number of particles in the zone.
   virtual std::size_t relax_split(const SplitParams& rules);
+  // The implicit viscous update of the materials marked implicit_viscosity (sph/implicit_viscosity.hpp),
+  // on the velocities as they are, over dt, on the positions and neighbour list of the last force
+  // pass. Structure particles add `share` x the reaction force to viscous_reaction (the share of
+  // the fluid step this update covers). Returns the conjugate-gradient iterations and whether the
+  // tolerance was reached.
+  virtual ViscousSolve solve_viscosity(double dt, double share);
+  virtual bool supports_implicit_viscosity() const { return false; }
 };
 
 std::unique_ptr<Backend> make_cpu_backend(int threads);

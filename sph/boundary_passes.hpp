@@ -47,11 +47,60 @@ TURBID_HD inline Real solve_small(Real (&A)[N][N], Real (&b)[N], Real (&x)[N]) {
   return det;
 }
 
+// Smallest singular value of a D x D matrix (D = 2 or 3): the square root of the smallest
+// eigenvalue of S^T S (closed form in 2D; in 3D the trigonometric solution of the characteristic
+// cubic of a symmetric matrix).
+template <int D>
+TURBID_HD inline Real smallest_singular_value(const Real (&S)[D][D]) {
+  Real M[D][D];
+  for (int a = 0; a < D; ++a)
+    for (int b = 0; b < D; ++b) {
+      Real m = 0;
+      for (int k = 0; k < D; ++k) m += S[k][a] * S[k][b];
+      M[a][b] = m;
+    }
+  Real lambda;
+  if constexpr (D == 2) {
+    const Real t = M[0][0] + M[1][1], d = M[0][0] * M[1][1] - M[0][1] * M[1][0];
+    const Real disc = t * t - Real(4) * d;
+    const Real big = Real(0.5) * (t + std::sqrt(disc > Real(0) ? disc : Real(0)));
+    lambda = big > Real(0) ? d / big : Real(0);  // the product over the larger root: no cancellation
+  } else {
+    const Real q = (M[0][0] + M[1][1] + M[2][2]) / Real(3);
+    const Real off = M[0][1] * M[0][1] + M[0][2] * M[0][2] + M[1][2] * M[1][2];
+    const Real p2 = (M[0][0] - q) * (M[0][0] - q) + (M[1][1] - q) * (M[1][1] - q) + (M[2][2] - q) * (M[2][2] - q) +
+                    Real(2) * off;
+    if (!(p2 > Real(0))) {
+      lambda = q;  // a multiple of the identity
+    } else {
+      const Real p = std::sqrt(p2 / Real(6));
+      Real B[3][3];
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) B[a][b] = (M[a][b] - (a == b ? q : Real(0))) / p;
+      Real r = Real(0.5) * (B[0][0] * (B[1][1] * B[2][2] - B[1][2] * B[2][1]) -
+                            B[0][1] * (B[1][0] * B[2][2] - B[1][2] * B[2][0]) +
+                            B[0][2] * (B[1][0] * B[2][1] - B[1][1] * B[2][0]));
+      r = r < Real(-1) ? Real(-1) : (r > Real(1) ? Real(1) : r);
+      const Real phi = std::acos(r) / Real(3);
+      lambda = q + Real(2) * p * std::cos(phi + Real(2.0943951023931957));  // + 2 pi / 3: the smallest root
+    }
+  }
+  return std::sqrt(lambda > Real(0) ? lambda : Real(0));
+}
+
+// Smallest gain (see ghost_interpolation) at which the first-order extrapolation is trusted: a
+// full support has about 1, a ghost beside a flat wall or a free surface 0.2-0.3, the thin tip of a
+// surge 0.003-0.1 (whose gradient across itself would be amplified 10-300 times).
+inline constexpr Real kMdbcMinGradientGain = Real(0.1);
+
 // First-order corrected SPH interpolation at a ghost node x_g over the fluid (physics.md C5):
 //   [ sum W V        sum x_jg^T W V        ] [ rho_g      ]   [ sum rho*_j W V      ]
 //   [ sum grad W V   sum grad W (x) x_jg V ] [ grad rho_g ] = [ sum rho*_j grad W V ]
 // `density` gets rho_g + (x_b - x_g) . grad rho_g with offset = x_g - x_b; where |det| < 1e-3
-// (too few neighbours on one side) the Shepard value sum rho* W V / sum V W. rho*_j is the density
+// (too few neighbours on one side), or where the fluid resolves the gradient in some direction
+// with a gain below kMdbcMinGradientGain (a film one or two particles thick: its gradient across
+// itself is noise amplified up to 300 times, which blew up a dam break's surge tip at the far
+// wall), the Shepard value sum rho* W V / sum V W. rho*_j is the density
 // that the boundary particle's equation of state `eos` (material `ref`) gives at j's pressure: rho_j
 // itself for a neighbour of material `ref` (m_j W, bit for bit as with one material), and
 // eos.density(p_j(rho_j)) for another. What is extrapolated is thus the fluid's pressure, which is
@@ -110,9 +159,16 @@ TURBID_HD inline Real ghost_interpolation(const ParticleView<D>& P, const GridVi
   const Real shepard = A[0][0];
   if (!(shepard > Real(0))) return Real(0);
   const Real shepard_density = rhs[0] / shepard;
+  // The gradient block once rho_g is eliminated: the Schur complement S = A_gg - A_g0 A_0g / A_00
+  // (dimensionless; about the identity in a full support). Its smallest singular value is the gain
+  // with which the fluid around x_g resolves the gradient in its worst direction.
+  Real S[D][D];
+  for (int a = 0; a < D; ++a)
+    for (int k = 0; k < D; ++k) S[a][k] = A[1 + a][1 + k] - A[1 + a][0] * A[0][1 + k] / shepard;
+  const Real gain = smallest_singular_value<D>(S);
   Real x[N] = {};
   const Real det = solve_small<N>(A, rhs, x);
-  if (std::fabs(det) >= Real(1e-3)) {
+  if (std::fabs(det) >= Real(1e-3) && gain >= kMdbcMinGradientGain) {
     density = x[0];
     for (int a = 0; a < D; ++a) density -= offset[a] * x[1 + a];  // (x_b - x_g) . grad rho_g
   } else {
@@ -246,6 +302,11 @@ struct StructureForcePass {
                                                        b, rib, r2);
         f -= P.mass[i] * a;
       });
+    }
+    // The implicit viscous updates' reaction on b since the last force pass (sph/implicit_viscosity.hpp).
+    if (P.viscous_reaction) {
+      f += P.viscous_reaction[b];
+      P.viscous_reaction[b] = Vec<D>::zero();
     }
     P.structure_force[b] = f;
   }

@@ -28,9 +28,12 @@ FieldIds register_fields(ParticleStore& s, const PhysicsParams& p, bool structur
   // outward normal (zero for fluid).
   if (p.boundary == Boundary::mdbc)
     f.boundary_normal = s.add_field({"boundary_normal", "m", ScalarType::f32, d, true, true, true, Carry::copy});
-  // Recomputed by the mDBC pass after every sort, before the momentum pass reads it.
+  // Recomputed by the mDBC pass after every sort, before the momentum pass reads it; the implicit
+  // viscous update at the start of the next step reads it too, so with implicit viscosity it is
+  // checkpointed (bit-identical resume), like the acceleration.
   if (p.boundary == Boundary::mdbc && p.mdbc_no_slip)
-    f.viscous_velocity = s.add_field({"viscous_velocity", "m/s", ScalarType::f32, d, false, false, false, Carry::recompute});
+    f.viscous_velocity = s.add_field(
+        {"viscous_velocity", "m/s", ScalarType::f32, d, false, p.implicit_viscosity, false, Carry::recompute});
   if (structures) {
     const char* force_unit = d == 2 ? "N/m" : "N";
     f.body = s.add_field({"body", "", ScalarType::u8, 1, true, true, true, Carry::copy});
@@ -47,12 +50,18 @@ FieldIds register_fields(ParticleStore& s, const PhysicsParams& p, bool structur
   // acceleration by the next half-kick: checkpointed for a bit-identical resume.
   if (p.shifting_coefficient > 0)
     f.shifting_velocity = s.add_field({"shifting_velocity", "m/s", ScalarType::f32, d, false, true, false, Carry::recompute});
-  // Recomputed by the rheology pass after every sort, before the momentum pass reads them.
+  // Recomputed by the rheology pass after every sort, before the momentum pass reads them; the
+  // implicit viscous update of the next step reads mu_eff too (checkpointed then).
   if (p.rheology) {
     f.shear_rate = s.add_field({"shear_rate", "1/s", ScalarType::f32, 1, true, false, false, Carry::recompute});
-    f.effective_viscosity =
-        s.add_field({"effective_viscosity", "Pa s", ScalarType::f32, 1, true, false, false, Carry::recompute});
+    f.effective_viscosity = s.add_field(
+        {"effective_viscosity", "Pa s", ScalarType::f32, 1, true, p.implicit_viscosity, false, Carry::recompute});
     f.shear_stress = s.add_field({"shear_stress", "Pa", ScalarType::f32, 1, true, false, false, Carry::recompute});
+  }
+  if (structures && p.implicit_viscosity) {
+    const char* force_unit = d == 2 ? "N/m" : "N";
+    f.viscous_reaction =
+        s.add_field({"viscous_reaction", force_unit, ScalarType::f32, d, false, true, true, Carry::recompute});
   }
   if (p.zone_count > 0) f.zone = s.add_field({"zone", "", ScalarType::u8, 1, true, true, true, Carry::copy});
   // Set by a split for its daughters and cleared by the next one; between steps it is read only by

@@ -22,6 +22,9 @@ struct FieldIds {
   FieldId shifting_velocity = -1;           // registered only with particle shifting
   FieldId split_fresh = -1;                 // registered only with transitions (1: daughter of the last split)
   FieldId shear_rate = -1, effective_viscosity = -1, shear_stress = -1;  // only with a non-Newtonian material
+  // Only with structures and implicit viscosity: the implicit viscous updates' reaction on each
+  // structure particle, summed until the next force pass reads and clears it.
+  FieldId viscous_reaction = -1;
 };
 
 // Registers what `params` needs (a water-only run with Fourtakas diffusion gets no gradient field).

@@ -43,6 +43,7 @@ struct ParticleView {
   Real* effective_viscosity = nullptr; // only with a non-Newtonian material: mu_eff [Pa s]
   Real* shear_stress = nullptr;        // only with a non-Newtonian material: sqrt(J2(tau)) = mu_eff gamma_dot [Pa]
   std::uint8_t* split_fresh = nullptr; // only with transitions: 1 for the daughters of the last split
+  Vec<D>* viscous_reaction = nullptr;  // only with structures and implicit viscosity: see implicit_viscosity.hpp
   // CPU only: positions as one array per coordinate (component a at a * soa_stride), a copy made
   // at each sort so that distance checks vectorise; valid until the next drift.
   const Real* position_soa = nullptr;
@@ -583,6 +584,14 @@ struct RheologyPass {
   }
 };
 
+// Whether the laminar viscous term of fluid particle i (material Mi) with j (material Mj if fluid_j)
+// belongs to the implicit viscous update: i's material is implicit and j is of the same kind of
+// material or a boundary particle. A pair of an implicit and an explicit material (debris and
+// water) stays explicit: its harmonic-mean viscosity is about twice the explicit side's.
+TURBID_HD inline bool implicit_pair(const MaterialParams& Mi, const MaterialParams& Mj, bool fluid_j) {
+  return Mi.implicit_viscosity && (!fluid_j || Mj.implicit_viscosity);
+}
+
 // Acceleration of fluid particle i (velocity vi, density rho_i, pressure p_i, smoothing length
 // h_i, material Mi, viscosity mu_i) due to particle j at r_ij = x_i - x_j: pressure and viscosity
 // (physics.md C10, C2). Boundary particles take the fluid's viscosity mu_i (no-slip in the fluid's
@@ -609,6 +618,9 @@ TURBID_HD inline Vec<D> momentum_pair(const ParticleView<D>& P, const PhysicsPar
   }
   const bool fluid_j = P.kind[j] == std::uint8_t(Kind::fluid);
   if (!fluid_j && P.free_slip && P.free_slip[j]) return s * rij;  // a free-slip wall exerts no shear
+  // Pairs of an implicitly integrated material with itself or a boundary: the implicit viscous
+  // update has them (sph/implicit_viscosity.hpp).
+  if (implicit_pair(Mi, Mj, fluid_j)) return s * rij;
   const Real mu_j = !fluid_j ? mu_i : (P.effective_viscosity ? P.effective_viscosity[j] : Mj.dynamic_viscosity);
   return s * rij + pair::laminar_viscosity(m_j, mu_i, mu_j, rho_i, rho_j, r2, eta2, F) * vij;
 }

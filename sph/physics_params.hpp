@@ -52,6 +52,9 @@ struct MaterialParams {
   Real dynamic_viscosity;  // mu [Pa s]; non-Newtonian: the largest mu_eff allowed (the cap)
   Rheology rheology;       // mu_eff(shear rate); Newtonian: consistency = mu, no yield stress
   bool non_newtonian = false;
+  // Its laminar viscous terms (between two of its particles, and with boundary particles) are
+  // integrated implicitly (sph/implicit_viscosity.hpp), the others explicitly in the momentum pass.
+  bool implicit_viscosity = false;
   // Smallest h among this material's particles [m], for its time-step limits; 0: the lattice's h.
   // Splitting lowers it for the materials daughters are made of.
   Real min_smoothing_length = 0;
@@ -100,6 +103,12 @@ struct PhysicsParams {
   // The paper's ghost-density correction of density diffusion between fluids of different
   // materials (seed paper eq. 3); off: no diffusion across an interface.
   bool interface_correction = false;
+  // Some material's viscous terms are implicit: the solver runs the implicit viscous update each
+  // step (conjugate gradients to a relative residual of implicit_tolerance, at most
+  // implicit_max_iterations iterations).
+  bool implicit_viscosity = false;
+  Real implicit_tolerance = Real(1e-5);
+  int implicit_max_iterations = 500;
   int material_count = 0;
   int wall_material = 0;       // EOS used for wall particles' pressure
   bool uniform_sound_speed = false;  // every material has the same c0 (pair loops skip the lookup)

@@ -19,7 +19,9 @@ double stable_time_step(const PhysicsParams& p, const TimeStepParams& t, double 
     const double nu = double(M.dynamic_viscosity) / double(M.eos.rest_density);
     dt = std::min(dt, t.cfl * h / (double(M.sound_speed) + max_speed));
     if (max_acceleration > 0) dt = std::min(dt, t.cfl * std::sqrt(h / max_acceleration));
-    if (p.viscosity == Viscosity::laminar && nu > 0) dt = std::min(dt, t.viscous_factor * h * h / nu);
+    // An implicitly integrated material sets no viscous limit (sph/implicit_viscosity.hpp).
+    if (p.viscosity == Viscosity::laminar && nu > 0 && !M.implicit_viscosity)
+      dt = std::min(dt, t.viscous_factor * h * h / nu);
   }
   return dt;
 }
@@ -63,6 +65,10 @@ void Solver::step(double dt) {
   }
   backend_->kick(0.5 * dt);
   if (coupling_) coupling_->after_kick(*backend_, 0.5 * dt);
+  // The stiff viscous terms over half a step after each half-kick (Strang splitting): the drift
+  // moves a plug with the velocity the viscous update left it, and the step ends with velocities
+  // the viscous terms have seen (a plug held by its yield stress shows no g dt / 2 of the kick).
+  if (params_.implicit_viscosity) solve_viscosity(0.5 * dt);
   backend_->compute_density_rate();
   backend_->drift(dt);
   if (coupling_) coupling_->after_drift(*backend_, dt);
@@ -76,6 +82,7 @@ void Solver::step(double dt) {
   if (coupling_) coupling_->after_forces(*backend_);
   backend_->kick(0.5 * dt);
   if (coupling_) coupling_->after_kick(*backend_, 0.5 * dt);
+  if (params_.implicit_viscosity) solve_viscosity(0.5 * dt);
   time_ += dt;
   last_dt_ = dt;
   ++steps_;
@@ -89,6 +96,14 @@ void Solver::step(double dt) {
     split_seconds_ += std::chrono::duration<double>(t1 - t0).count();
     step_seconds_ += std::chrono::duration<double>(t1 - step_start).count();
   }
+}
+
+void Solver::solve_viscosity(double dt) {
+  // dt is half the step: the reaction on structures counts half towards the step's mean force.
+  const ViscousSolve v = backend_->solve_viscosity(dt, 0.5);  // each of the step's two halves
+  viscous_iterations_ += std::uint64_t(v.iterations);
+  viscous_iterations_max_ = std::max(viscous_iterations_max_, v.iterations);
+  if (!v.converged) ++viscous_unconverged_;
 }
 
 void Solver::split() {

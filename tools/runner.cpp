@@ -418,8 +418,12 @@ std::string describe_scene(const fsi::Scene& scene) {
     os << " (yield stress " << mat.yield_stress << " Pa, "
        << (mat.model == "bingham" ? "plastic viscosity " + std::to_string(mat.viscosity) + " Pa s"
                                   : "K " + std::to_string(mat.consistency) + " Pa s^n, n " + std::to_string(mat.flow_index))
-       << ", m " << mat.papanastasiou_exponent << " s), effective viscosity capped at "
-       << params.materials[m].rheology.max_viscosity << " Pa s" << (mat.max_viscosity > 0 ? "" : " (automatic)") << "\n";
+       << ", m " << mat.papanastasiou_exponent << " s), ";
+    const double bound = params.materials[m].rheology.bound();
+    if (mat.max_viscosity > 0) os << "effective viscosity capped at " << mat.max_viscosity << " Pa s (stated)";
+    else if (std::isfinite(bound)) os << "largest effective viscosity " << bound << " Pa s (at rest)";
+    else os << "effective viscosity unbounded (power law)";
+    os << ", viscous terms " << (params.materials[m].implicit_viscosity ? "implicit" : "explicit") << "\n";
   }
   os << "domain           [" << s.domain.min[0] << ", " << s.domain.max[0] << "] x [" << s.domain.min[1] << ", "
      << s.domain.max[1] << "]";
@@ -564,6 +568,13 @@ nlohmann::json run_scene(const RunRequest& request) {
     // rebuild in steps with splits), this process only.
     report["split_wall_seconds"] = sim.split_seconds();
     report["split_share_of_step_time"] = sim.step_seconds() > 0 ? sim.split_seconds() / sim.step_seconds() : 0.0;
+  }
+  if (sim.params().implicit_viscosity) {
+    // Implicit viscosity (sph/implicit_viscosity.hpp): conjugate-gradient iterations, this process.
+    const auto& sv = sim.solver();
+    report["viscous_iterations_mean"] = sim.steps() > 0 ? double(sv.viscous_iterations()) / double(sim.steps()) : 0.0;
+    report["viscous_iterations_max"] = sv.viscous_iterations_max();
+    report["viscous_unconverged_steps"] = sv.viscous_unconverged();
   }
   report["steps"] = sim.steps();
   report["simulated_time"] = sim.time();

@@ -584,7 +584,7 @@ void Reader::read_numerics(const Value& v, fsi::NumericsSpec& n) const {
     }
   }
   if (auto vv = m.get("viscosity")) {
-    MapView visc(*this, *vv, {"type", "alpha"});
+    MapView visc(*this, *vv, {"type", "alpha", "integration"});
     if (auto t = visc.get("type"))
       n.viscosity = choice(*t, {"artificial", "laminar"}) == 0 ? fsi::ViscosityKind::artificial
                                                                : fsi::ViscosityKind::laminar;
@@ -593,6 +593,13 @@ void Reader::read_numerics(const Value& v, fsi::NumericsSpec& n) const {
         fail(visc.key_mark("alpha"),
              "'alpha' applies only to 'artificial' viscosity; 'laminar' uses each material's 'viscosity'");
       n.artificial_viscosity = number(*alpha, non_negative());
+    }
+    if (auto integ = visc.get("integration")) {
+      if (n.viscosity != fsi::ViscosityKind::laminar)
+        fail(visc.key_mark("integration"), "'integration' applies only to 'laminar' viscosity");
+      const int k = choice(*integ, {"auto", "explicit", "implicit"});
+      n.viscous_integration = k == 0 ? fsi::ViscousIntegration::automatic
+                                     : (k == 1 ? fsi::ViscousIntegration::explicit_ : fsi::ViscousIntegration::implicit);
     }
   }
   if (auto sv = m.get("shifting")) {

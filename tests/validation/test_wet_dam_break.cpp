@@ -48,9 +48,10 @@ Totals totals(const Simulation& sim) {
 
 }  // namespace
 
-TEST(ValidationWetDamBreak, HerschelBulkleyColumnIntoWaterConservesAndStaysInside) {
+static void check_wet_dam_break(turbid::fsi::BoundaryKind boundary) {
   Scene s = turbid::tools::read_scene_file(std::string(TURBID_SOURCE_DIR) + "/scenes/wet_dam_break_hb_2d.yaml");
   if (!turbid::validation::full_mode()) s.particle_spacing = 0.01;
+  s.numerics.boundary = boundary;
   s.output.vtk = false;
   const double dx = s.particle_spacing;
   const auto& tank = s.walls.at(0).box;
@@ -82,6 +83,17 @@ TEST(ValidationWetDamBreak, HerschelBulkleyColumnIntoWaterConservesAndStaysInsid
   }
   EXPECT_EQ(sim.removed(), 0u);
   EXPECT_EQ(outside, 0u) << "fluid particle positions outside the tank at output times";
-  std::printf("wet dam break, dx = %g m: t = %.3f s, %llu steps, debris front %.3f m\n", dx, sim.time(),
+  std::printf("wet dam break, %s walls, dx = %g m: t = %.3f s, %llu steps, debris front %.3f m\n",
+              boundary == turbid::fsi::BoundaryKind::mdbc ? "mDBC" : "DBC", dx, sim.time(),
               static_cast<unsigned long long>(sim.steps()), sim.probe_values()[0]);
+}
+
+TEST(ValidationWetDamBreak, HerschelBulkleyColumnIntoWaterConservesAndStaysInside) {
+  check_wet_dam_break(turbid::fsi::BoundaryKind::dbc);
+}
+
+// The same with mDBC walls and the same bounds (issue #20 item 3): walls under the debris convert its
+// relative density with the debris' equation of state (before: water's at 1.8 rho0_w, a blow-up).
+TEST(ValidationWetDamBreak, HerschelBulkleyColumnIntoWaterWithMdbcWalls) {
+  check_wet_dam_break(turbid::fsi::BoundaryKind::mdbc);
 }

@@ -11,6 +11,7 @@
 #include "sph/backend.hpp"
 #include "sph/boundary_passes.hpp"
 #include "sph/dispatch.hpp"
+#include "sph/implicit_viscosity.hpp"
 #include "sph/passes.hpp"
 #include "sph/splitting.hpp"
 
@@ -119,6 +120,100 @@ class CpuBackend final : public Backend {
   }
   std::size_t relax_split(const SplitParams& rules) override {
     return params_.dimensions == 2 ? relax_impl<2>(rules) : relax_impl<3>(rules);
+  }
+
+  bool supports_implicit_viscosity() const override { return true; }
+  ViscousSolve solve_viscosity(double dt, double share) override {
+    return params_.dimensions == 2 ? viscosity_impl<2>(Real(dt), Real(share)) : viscosity_impl<3>(Real(dt), Real(share));
+  }
+
+  // Sum over particles of f(i) in double, in blocks of fixed size added in order: the same bits
+  // for any number of threads (an OpenMP reduction would combine partial sums per thread).
+  template <class F>
+  double fixed_order_sum(std::uint32_t n, const F& f) {
+    constexpr std::uint32_t kBlock = 2048;
+    const std::int64_t blocks = (std::int64_t(n) + kBlock - 1) / kBlock;
+    block_sums_.assign(std::size_t(blocks), 0.0);
+#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
+    for (std::int64_t b = 0; b < blocks; ++b) {
+      double s = 0;
+      const std::uint32_t end = std::min<std::uint32_t>(n, std::uint32_t(b + 1) * kBlock);
+      for (std::uint32_t i = std::uint32_t(b) * kBlock; i < end; ++i) s += f(i);
+      block_sums_[std::size_t(b)] = s;
+    }
+    double total = 0;
+    for (double s : block_sums_) total += s;
+    return total;
+  }
+
+  // Jacobi-preconditioned conjugate gradients on the implicit viscous system (see
+  // sph/implicit_viscosity.hpp), in the inner product weighted by particle mass, in which the
+  // system is symmetric; starts from the current velocities.
+  template <int D>
+  ViscousSolve viscosity_impl(Real dt, Real share) {
+    const ParticleView<D> P = view<D>();
+    const GridView<D> G = grid<D>();
+    const std::uint32_t n = P.count;
+    ViscousSolve out;
+    std::vector<Vec<D>>* cg_ = cg_vectors<D>();
+    std::vector<Vec<D>>& x = cg_[0];
+    std::vector<Vec<D>>& r = cg_[1];
+    std::vector<Vec<D>>& z = cg_[2];
+    std::vector<Vec<D>>& p = cg_[3];
+    std::vector<Vec<D>>& q = cg_[4];
+    for (int k = 0; k < 5; ++k) cg_[k].resize(n);
+    cg_diag_.resize(n);
+    Real* diag = cg_diag_.data();
+    const NeighbourList L = list(false);
+    const auto dot = [&](const std::vector<Vec<D>>& a, const std::vector<Vec<D>>& b) {
+      return fixed_order_sum(n, [&](std::uint32_t i) {
+        return diag[i] == Real(0) ? 0.0 : double(P.mass[i]) * double(turbid::sph::dot(a[i], b[i]));
+      });
+    };
+    dispatch_kernel<D>(params_, [&](auto kernel_tag, auto uniform_tag) {
+      using K = typename decltype(kernel_tag)::type;
+      constexpr bool U = decltype(uniform_tag)::value;
+      parallel_for(n, ViscousSystemPass<D, K, U>{P, G, params_, L, dt, diag, r.data()});  // r = b for now
+      parallel_for(n, [&](std::uint32_t i) { x[i] = P.velocity[i]; });
+      parallel_for(n, ViscousApplyPass<D, K, U>{P, G, params_, L, dt, diag, x.data(), q.data()});
+      const double b_norm = std::sqrt(dot(r, r));
+      parallel_for(n, [&](std::uint32_t i) {
+        r[i] = diag[i] == Real(0) ? Vec<D>::zero() : r[i] - q[i];
+        z[i] = diag[i] == Real(0) ? Vec<D>::zero() : (Real(1) / diag[i]) * r[i];
+        p[i] = z[i];
+      });
+      double rz = dot(r, z);
+      double res = b_norm > 0 ? std::sqrt(dot(r, r)) / b_norm : 0.0;
+      const double tol = double(params_.implicit_tolerance);
+      int k = 0;
+      while (res > tol && k < params_.implicit_max_iterations) {
+        parallel_for(n, ViscousApplyPass<D, K, U>{P, G, params_, L, dt, diag, p.data(), q.data()});
+        const double pq = dot(p, q);
+        if (!(pq > 0)) break;
+        const Real alpha = Real(rz / pq);
+        parallel_for(n, [&](std::uint32_t i) {
+          if (diag[i] == Real(0)) return;
+          x[i] += alpha * p[i];
+          r[i] -= alpha * q[i];
+          z[i] = (Real(1) / diag[i]) * r[i];
+        });
+        ++k;
+        res = std::sqrt(dot(r, r)) / b_norm;
+        const double rz_next = dot(r, z);
+        const Real beta = Real(rz_next / rz);
+        rz = rz_next;
+        parallel_for(n, [&](std::uint32_t i) {
+          if (diag[i] != Real(0)) p[i] = z[i] + beta * p[i];
+        });
+      }
+      out.iterations = k;
+      out.residual = res;
+      out.converged = res <= tol;
+      parallel_for(n, ViscousUpdatePass<D, K, U>{P, G, params_, L, dt, diag, x.data()});
+      if (P.viscous_reaction)
+        parallel_for(n, ViscousReactionPass<D, K, U>{P, G, params_, diag, x.data(), P.viscous_reaction, share});
+    });
+    return out;
   }
 
   template <int D>
@@ -268,6 +363,7 @@ class CpuBackend final : public Backend {
     if (ids_.effective_viscosity >= 0) v.effective_viscosity = s.data<Real>(ids_.effective_viscosity);
     if (ids_.shear_stress >= 0) v.shear_stress = s.data<Real>(ids_.shear_stress);
     if (ids_.split_fresh >= 0) v.split_fresh = s.data<std::uint8_t>(ids_.split_fresh);
+    if (ids_.viscous_reaction >= 0) v.viscous_reaction = s.data<Vec<D>>(ids_.viscous_reaction);
     v.count = std::uint32_t(s.size());
     if (soa_valid_) {
       v.position_soa = soa_.data();
@@ -498,6 +594,17 @@ class CpuBackend final : public Backend {
   std::uint32_t list_stride_ = 0;
   bool list_valid_ = false;
   std::vector<Real> soa_;
+  // Implicit viscosity: the conjugate-gradient vectors (x, r, z, p, A p) per dimension, the
+  // diagonal, and the block sums of the fixed-order reductions.
+  std::vector<Vec<2>> cg2_[5];
+  std::vector<Vec<3>> cg3_[5];
+  std::vector<Real> cg_diag_;
+  std::vector<double> block_sums_;
+  template <int D>
+  std::vector<Vec<D>>* cg_vectors() {
+    if constexpr (D == 2) return cg2_;
+    else return cg3_;
+  }
   std::size_t soa_stride_ = 0;
   bool soa_valid_ = false;
 };
