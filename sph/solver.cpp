@@ -123,7 +123,6 @@ void Solver::split() {
     backend_->compute_forces();
     // A body's next half-kick takes the fluid's load on the particles as they are now, as the fluid's does.
     if (coupling_) coupling_->after_forces(*backend_);
-    if (coupling_) coupling_->after_forces(*backend_);
     check("the split after step");
   }
   if (c.refused > 0 && split_error_when_full_) {
