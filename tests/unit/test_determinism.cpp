@@ -156,3 +156,48 @@ output: {every: 0.025, vtk: true, forces_every: 0.01}
 )");
   EXPECT_GE(frames, 4);
 }
+
+// An inlet of a material other than the walls' (issue #20 item 3): its buffer particles hold their
+// own material's density (1950 kg/m^3) and must be converted with that material's equation of state
+// and judged against its rest density. Before, both used material 0's (water): the health check read
+// 1950 / 1000 - 1 = 0.95 and stopped the run at the first step (as did the mDBC walls, which read
+// the mud's density as water's). What must hold: the run completes and mud enters at the inlet.
+TEST(OpenBoundaries, InletOfASecondMaterialUsesItsOwnEquationOfState) {
+  const fs::path dir = fs::temp_directory_path() / ("turbid_inlet_material_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "scene.yaml") << R"(name: inlet_second_material
+dimensions: 2
+resolution: {particle_spacing: 0.01, smoothing_ratio: 2.0}
+time: {end: 0.05, cfl: 0.2}
+gravity: [0, 0]
+numerics:
+  density_diffusion: {type: fourtakas, delta: 0.1}
+  viscosity: {type: laminar}
+  boundary: {type: mdbc, velocity: no_slip}
+materials:
+  water: {model: newtonian, density: 1000, viscosity: 1.0e-3, sound_speed: 3.0}
+  mud: {model: newtonian, density: 1950, viscosity: 0.1, sound_speed: 3.0}
+walls:
+  - box: {min: [-0.08, 0], max: [1.08, 0.2]}
+    open: [-x, +x]
+open_boundaries:
+  - {name: inlet, type: inlet, box: {min: [-0.08, 0], max: [0, 0.2]}, direction: +x, material: mud,
+     velocity: {profile: uniform, mean: 0.2}}
+  - {name: outlet, type: outlet, box: {min: [1.0, 0], max: [1.08, 0.2]}, direction: +x}
+fluids:
+  - material: mud
+    box: {min: [0, 0], max: [1.0, 0.2]}
+    initial_velocity: {direction: +x, profile: uniform, mean: 0.2}
+output: {every: 0.05, vtk: true}
+)";
+  turbid::tools::RunRequest r;
+  r.scene_file = dir / "scene.yaml";
+  r.out = dir / "out";
+  r.backend = "cpu";
+  r.progress = false;
+  const nlohmann::json report = turbid::tools::run_scene(r);
+  EXPECT_EQ(report.at("status"), "completed") << report.dump();
+  EXPECT_GT(report.at("inflow_particles").get<long>(), 0);
+  fs::remove_all(dir);
+}
