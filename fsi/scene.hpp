@@ -22,10 +22,14 @@ struct SourceLocation {
 
 enum class DiffusionKind { none, molteni, antuono, fourtakas };
 enum class ViscosityKind { artificial, laminar };
-// How the laminar viscous terms of non-Newtonian materials are integrated: implicitly where the
-// material's largest viscosity would put the explicit viscous limit below the acoustic one (auto),
-// or always one way (docs/choices.md).
+// How the laminar viscous terms are integrated: auto, implicitly for a non-Newtonian material
+// whose largest viscosity would put the explicit viscous limit below the acoustic one, explicitly
+// otherwise; explicit or implicit: every material that way (docs/choices.md).
 enum class ViscousIntegration { automatic, explicit_, implicit };
+// The laminar viscous pair term (sph::pair::ViscousPair, docs/choices.md): Morris' Laplacian form
+// div(mu grad v) (the default), or the central pair form, whose limit is the divergence of
+// mu (grad v + grad v^T) + mu (div v) I (full stress plus a bulk viscosity).
+enum class ViscousStress { laplacian, central };
 enum class BoundaryKind { dbc, mdbc };  // wall treatment; see docs/choices.md
 
 // A material's rheology (physics.md C8): newtonian (viscosity), bingham (yield_stress and the
@@ -267,6 +271,7 @@ struct NumericsSpec {
   ViscosityKind viscosity = ViscosityKind::artificial;
   double artificial_viscosity = 0.01;      // Monaghan alpha [-]
   ViscousIntegration viscous_integration = ViscousIntegration::automatic;
+  ViscousStress viscous_stress = ViscousStress::laplacian;
   double cfl = 0.2;                        // Courant number for the acoustic and force limits [-]
   double viscous_dt_factor = 0.125;        // dt <= factor h^2 / nu_max (Morris et al. 1997)
   double min_time_step = 1.0e-9;           // a smaller dt stops the run as collapsed [s]

@@ -460,6 +460,12 @@ sph::PhysicsParams physics_params(const Scene& scene) {
     p.materials[m].sound_speed = sph::Real(c0);
     p.materials[m].dynamic_viscosity = sph::Real(ms.viscosity);
     p.materials[m].rheology.consistency = sph::Real(ms.viscosity);
+    const bool laminar = scene.numerics.viscosity == ViscosityKind::laminar;
+    p.materials[m].central_stress = laminar && scene.numerics.viscous_stress == ViscousStress::central;
+    // A Newtonian material is implicit only where the scene asks for every material implicit.
+    p.materials[m].implicit_viscosity = laminar && ms.viscosity > 0 &&
+                                        scene.numerics.viscous_integration == ViscousIntegration::implicit;
+    p.implicit_viscosity = p.implicit_viscosity || p.materials[m].implicit_viscosity;
     if (ms.model != "newtonian") {
       sph::Rheology& r = p.materials[m].rheology;
       r.yield_stress = sph::Real(ms.yield_stress);
@@ -472,8 +478,7 @@ sph::PhysicsParams physics_params(const Scene& scene) {
         throw std::invalid_argument(material_error(ms) +
                                     "a shear-thinning power law without a yield stress has no viscosity at rest; "
                                     "state 'max_viscosity' [Pa s]");
-      const bool implicit = scene.numerics.viscosity == ViscosityKind::laminar &&
-                            implicit_viscosity(scene, ms, r, c0, scene.smoothing_ratio * scene.particle_spacing);
+      const bool implicit = laminar && implicit_viscosity(scene, ms, r, c0, scene.smoothing_ratio * scene.particle_spacing);
       // The explicit viscous time-step limit sees the largest mu_eff possible; an implicit
       // material sets no viscous limit.
       const double bound = r.bound();

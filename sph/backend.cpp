@@ -13,7 +13,7 @@ std::size_t Backend::relax_split(const SplitParams&) {
   throw std::logic_error("the relaxation after a split is not implemented on the " + name() + " backend yet");
 }
 
-ViscousSolve Backend::solve_viscosity(double, double) {
+ViscousSolve Backend::solve_viscosity(double, double, bool) {
   throw std::runtime_error("implicit viscosity is not implemented on the " + name() + " backend yet; use --backend cpu");
 }
 

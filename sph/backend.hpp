@@ -83,10 +83,11 @@ class Backend {
   virtual std::size_t relax_split(const SplitParams& rules);
   // The implicit viscous update of the materials marked implicit_viscosity (sph/implicit_viscosity.hpp),
   // on the velocities as they are, over dt, on the positions and neighbour list of the last force
-  // pass. Structure particles add `share` x the reaction force to viscous_reaction (the share of
-  // the fluid step this update covers). Returns the conjugate-gradient iterations and whether the
-  // tolerance was reached.
-  virtual ViscousSolve solve_viscosity(double dt, double share);
+  // pass. Structure particles take `share` x the reaction force (the share of the fluid step this
+  // update covers) into the step's viscous load: the first update of a step into viscous_load, the
+  // second into viscous_pending (ViscousReactionPass). Returns the conjugate-gradient iterations and
+  // whether the tolerance was reached.
+  virtual ViscousSolve solve_viscosity(double dt, double share, bool first_half);
   virtual bool supports_implicit_viscosity() const { return false; }
 };
 

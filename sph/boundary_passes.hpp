@@ -303,11 +303,8 @@ struct StructureForcePass {
         f -= P.mass[i] * a;
       });
     }
-    // The implicit viscous updates' reaction on b since the last force pass (sph/implicit_viscosity.hpp).
-    if (P.viscous_reaction) {
-      f += P.viscous_reaction[b];
-      P.viscous_reaction[b] = Vec<D>::zero();
-    }
+    // The implicit viscous updates' load on b for this step (sph/implicit_viscosity.hpp).
+    if (P.viscous_load) f += P.viscous_load[b];
     P.structure_force[b] = f;
   }
 };

@@ -60,8 +60,11 @@ FieldIds register_fields(ParticleStore& s, const PhysicsParams& p, bool structur
   }
   if (structures && p.implicit_viscosity) {
     const char* force_unit = d == 2 ? "N/m" : "N";
-    f.viscous_reaction =
-        s.add_field({"viscous_reaction", force_unit, ScalarType::f32, d, false, true, true, Carry::recompute});
+    // The implicit viscous updates' reaction on structure particles (sph/implicit_viscosity.hpp):
+    // the step's load, and the second half-step's share waiting for the next step.
+    f.viscous_load = s.add_field({"viscous_load", force_unit, ScalarType::f32, d, false, true, true, Carry::recompute});
+    f.viscous_pending =
+        s.add_field({"viscous_pending", force_unit, ScalarType::f32, d, false, true, true, Carry::recompute});
   }
   if (p.zone_count > 0) f.zone = s.add_field({"zone", "", ScalarType::u8, 1, true, true, true, Carry::copy});
   // Set by a split for its daughters and cleared by the next one; between steps it is read only by

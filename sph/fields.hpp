@@ -24,7 +24,7 @@ struct FieldIds {
   FieldId shear_rate = -1, effective_viscosity = -1, shear_stress = -1;  // only with a non-Newtonian material
   // Only with structures and implicit viscosity: the implicit viscous updates' reaction on each
   // structure particle, summed until the next force pass reads and clears it.
-  FieldId viscous_reaction = -1;
+  FieldId viscous_load = -1, viscous_pending = -1;
 };
 
 // Registers what `params` needs (a water-only run with Fourtakas diffusion gets no gradient field).

@@ -4,22 +4,24 @@
 // the landslide's debris); the explicit viscous limit dt <= 0.125 h^2 rho / mu would then be ~100
 // times below the acoustic one. Capping mu at what the explicit limit allows made the material
 // depend on h (issue #20). Instead the viscous terms of such materials are integrated implicitly:
-// with Morris' pair term s_ij (v_i - v_j) (pair::laminar_viscosity, s_ij <= 0),
+// with the pair operator T_ij of pair::ViscousPair (Morris' s_ij I, or the central form
+// k_ij r_ij r_ij^T; negative semidefinite and symmetric in i, j),
 //
-//   v_i - dt sum_j s_ij (v_i - v_j) = v*_i          (v* after the half-kick of the explicit forces)
+//   v_i - dt sum_j T_ij (v_i - v_j) = v*_i          (v* after the half-kick of the explicit forces)
 //
 // over the pairs implicit_pair() selects: i of an implicit material with j of an implicit
 // material (unknown v_j) or a boundary particle (known: the velocity it shows viscous terms). The
-// matrix is symmetric in the mass-weighted inner product (m_i s_ij = m_j s_ji: pair h, harmonic
-// viscosity and kernel are symmetric) and diagonally dominant, so the backend solves it with
-// Jacobi-preconditioned conjugate gradients. Viscosities are those of the last rheology pass
+// matrix is symmetric in the mass-weighted inner product (m_i T_ij = m_j T_ji: pair h, harmonic
+// viscosity and kernel are symmetric) and positive definite (identity minus dt times a negative
+// semidefinite operator), so the backend solves it with conjugate gradients preconditioned by its
+// diagonal (per component). Viscosities are those of the last rheology pass
 // (lagged one step, the usual linearisation of a generalised Newtonian fluid).
 //
 // The update itself is the explicit pair sum evaluated with the solution x:
-//   v_i = v*_i + dt sum_j s_ij (x_i - x_j),
+//   v_i = v*_i + dt sum_j T_ij (x_i - x_j),
 // which equals x_i up to the solver's residual and conserves momentum to rounding (the pair terms
 // are antisymmetric), whatever the tolerance. A structure particle b gets the exact reaction,
-// -sum_i m_i s_ib (x_i - v_b), in the field viscous_reaction (StructureForcePass adds it).
+// -sum_i m_i T_ib (x_i - v_b) (ViscousReactionPass; StructureForcePass adds it to b's force).
 #pragma once
 #include <cmath>
 #include <cstdint>
@@ -36,7 +38,7 @@ TURBID_HD inline bool in_viscous_system(const ParticleView<D>& P, const PhysicsP
   return P.kind[i] == std::uint8_t(Kind::fluid) && prm.materials[P.material[i]].implicit_viscosity;
 }
 
-// Calls f(j, s_ij, boundary_j) for every implicit pair of system particle i (see above).
+// Calls f(j, T_ij, boundary_j) for every implicit pair of system particle i (see above).
 template <int D, class K, bool UniformH, class Visit>
 TURBID_HD inline void for_each_implicit_pair(const ParticleView<D>& P, const GridView<D>& G, const NeighbourList& L,
                                              const PhysicsParams& prm, std::uint32_t i, Visit&& f) {
@@ -45,7 +47,7 @@ TURBID_HD inline void for_each_implicit_pair(const ParticleView<D>& P, const Gri
   const Real h_i = UniformH ? prm.smoothing_length : P.smoothing_length[i];
   const MaterialParams& Mi = prm.materials[P.material[i]];
   const Real mu_i = P.effective_viscosity ? P.effective_viscosity[i] : Mi.dynamic_viscosity;
-  for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>&, Real r2) {
+  for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
     const Real h = pair_h<D, K>(P, prm, UniformH, h_i, j);
     if (!UniformH && r2 >= Real(4) * h * h) return;
     const bool fluid_j = P.kind[j] == std::uint8_t(Kind::fluid);
@@ -54,13 +56,21 @@ TURBID_HD inline void for_each_implicit_pair(const ParticleView<D>& P, const Gri
     if (!implicit_pair(Mi, Mj, fluid_j)) return;
     const Real mu_j = !fluid_j ? mu_i : (P.effective_viscosity ? P.effective_viscosity[j] : Mj.dynamic_viscosity);
     const Real F = K::f_inv(std::sqrt(r2), Real(1) / h);
-    const Real s = pair::laminar_viscosity(P.mass[j], mu_i, mu_j, rho_i, P.density[j], r2, kEta2Factor * h * h, F);
-    f(j, s, !fluid_j);
+    f(j,
+      pair::viscous_pair<D>(central_stress_pair(Mi, Mj, fluid_j), P.mass[j], mu_i, mu_j, rho_i, P.density[j], r2,
+                            kEta2Factor * h * h, F, rij),
+      !fluid_j);
   });
 }
 
-// The system's diagonal 1 - dt sum_j s_ij and right-hand side v*_i - dt sum_boundary s_ij v_j for
-// system particles; diagonal 0 (not in the system) for the others.
+// Whether particle i is in the system: its diagonal is at least 1 then, 0 otherwise.
+template <int D>
+TURBID_HD inline bool in_system(const Vec<D>* diag, std::uint32_t i) {
+  return diag[i][0] != Real(0);
+}
+
+// The system's diagonal 1 - dt sum_j diag(T_ij) (per component) and right-hand side
+// v*_i - dt sum_boundary T_ij v_j for system particles; diagonal 0 (not in the system) for the others.
 template <int D, class K, bool UniformH>
 struct ViscousSystemPass {
   ParticleView<D> P;
@@ -68,27 +78,30 @@ struct ViscousSystemPass {
   PhysicsParams prm;
   NeighbourList L;
   Real dt;
-  Real* diag;
+  Vec<D>* diag;
   Vec<D>* rhs;
 
   TURBID_HD void operator()(std::uint32_t i) const {
     if (!in_viscous_system<D>(P, prm, i)) {
-      diag[i] = Real(0);
+      diag[i] = Vec<D>::zero();
       rhs[i] = Vec<D>::zero();
       return;
     }
-    Real sum = 0;
+    Vec<D> sum = Vec<D>::zero();
     Vec<D> known = Vec<D>::zero();
-    for_each_implicit_pair<D, K, UniformH>(P, G, L, prm, i, [&](std::uint32_t j, Real s, bool boundary) {
-      sum += s;
-      if (boundary) known += s * viscous_velocity_of<D>(P, j);
+    for_each_implicit_pair<D, K, UniformH>(P, G, L, prm, i, [&](std::uint32_t j, const pair::ViscousPair<D>& T, bool boundary) {
+      sum += T.diagonal();
+      if (boundary) known += T.apply(viscous_velocity_of<D>(P, j));
     });
-    diag[i] = Real(1) - dt * sum;
+    Vec<D> d;
+    for (int a = 0; a < D; ++a) d[a] = Real(1) - dt * sum[a];
+    diag[i] = d;
     rhs[i] = P.velocity[i] - dt * known;
   }
 };
 
-// out_i = (A x)_i = diag_i x_i + dt sum_{fluid j} s_ij x_j for system particles; 0 for the others.
+// out_i = (A x)_i = x_i - dt sum_j T_ij (x_i - x_j) + dt sum_boundary T_ij v_j, i.e. A x without
+// the known boundary velocities, for system particles; 0 for the others.
 template <int D, class K, bool UniformH>
 struct ViscousApplyPass {
   ParticleView<D> P;
@@ -96,24 +109,25 @@ struct ViscousApplyPass {
   PhysicsParams prm;
   NeighbourList L;
   Real dt;
-  const Real* diag;
+  const Vec<D>* diag;
   const Vec<D>* x;
   Vec<D>* out;
 
   TURBID_HD void operator()(std::uint32_t i) const {
-    if (diag[i] == Real(0)) {
+    if (!in_system<D>(diag, i)) {
       out[i] = Vec<D>::zero();
       return;
     }
-    Vec<D> off = Vec<D>::zero();
-    for_each_implicit_pair<D, K, UniformH>(P, G, L, prm, i, [&](std::uint32_t j, Real s, bool boundary) {
-      if (!boundary) off += s * x[j];
+    const Vec<D> xi = x[i];
+    Vec<D> a = Vec<D>::zero();
+    for_each_implicit_pair<D, K, UniformH>(P, G, L, prm, i, [&](std::uint32_t j, const pair::ViscousPair<D>& T, bool boundary) {
+      a += T.apply(boundary ? xi : xi - x[j]);
     });
-    out[i] = diag[i] * x[i] + dt * off;
+    out[i] = xi - dt * a;
   }
 };
 
-// The update: v_i = v*_i + dt sum_j s_ij (x_i - x_j) for system particles (boundary j with the
+// The update: v_i = v*_i + dt sum_j T_ij (x_i - x_j) for system particles (boundary j with the
 // velocity they show viscous terms). Reads x and boundary velocities, writes fluid velocities.
 template <int D, class K, bool UniformH>
 struct ViscousUpdatePass {
@@ -122,34 +136,36 @@ struct ViscousUpdatePass {
   PhysicsParams prm;
   NeighbourList L;
   Real dt;
-  const Real* diag;
+  const Vec<D>* diag;
   const Vec<D>* x;
 
   TURBID_HD void operator()(std::uint32_t i) const {
-    if (diag[i] == Real(0)) return;
+    if (!in_system<D>(diag, i)) return;
     const Vec<D> xi = x[i];
     Vec<D> a = Vec<D>::zero();
-    for_each_implicit_pair<D, K, UniformH>(P, G, L, prm, i, [&](std::uint32_t j, Real s, bool boundary) {
-      a += s * (xi - (boundary ? viscous_velocity_of<D>(P, j) : x[j]));
+    for_each_implicit_pair<D, K, UniformH>(P, G, L, prm, i, [&](std::uint32_t j, const pair::ViscousPair<D>& T, bool boundary) {
+      a += T.apply(xi - (boundary ? viscous_velocity_of<D>(P, j) : x[j]));
     });
     P.velocity[i] += dt * a;
   }
 };
 
 // Structure particle b: the reaction of the implicit viscous force its fluid neighbours got,
-// -sum_i m_i s_ib (x_i - v_b) [N/m in 2D, N in 3D], with s_ib evaluated from the same arguments as
-// for_each_implicit_pair gives it on i's side (the same bits), weighted by this update's share
-// of the fluid step and added to `reaction`, which the structure force pass reads and
-// clears (the two half-step updates around one force pass make one step's mean force).
+// -sum_i m_i T_ib (x_i - v_b) [N/m in 2D, N in 3D], with T_ib evaluated from the same arguments as
+// for_each_implicit_pair gives it on i's side, times this update's share of the fluid step.
+// The step's load on b (what the structure force passes add to b's force until the next step's
+// first update) is the first half-step update's share plus the second half-step update's share of
+// the step before: the first update writes load = pending + share f, the second pending = share f.
+// Force passes between steps (a split's) so see the same viscous load as the step's own.
 template <int D, class K, bool UniformH>
 struct ViscousReactionPass {
   ParticleView<D> P;
   GridView<D> G;
   PhysicsParams prm;
-  const Real* diag;
+  const Vec<D>* diag;
   const Vec<D>* x;
-  Vec<D>* reaction;
-  Real share;  // this update's share of the fluid step (its dt / the step's dt)
+  Real share;        // this update's share of the fluid step (its dt / the step's dt)
+  bool first_half;   // the step's first update (else its second)
 
   TURBID_HD void operator()(std::uint32_t b) const {
     Vec<D> f = Vec<D>::zero();
@@ -157,18 +173,22 @@ struct ViscousReactionPass {
     if (P.kind[b] == std::uint8_t(Kind::structure) && !(P.free_slip && P.free_slip[b]) && G.cell_of(P.position[b], c) &&
         G.fluid_near(c)) {
       const Vec<D> vb = viscous_velocity_of<D>(P, b);
-      for_each_neighbour<D>(P, G, NeighbourList{}, prm, b, P.position[b], [&](std::uint32_t i, const Vec<D>&, Real r2) {
-        if (diag[i] == Real(0)) return;  // not an implicit fluid particle
+      for_each_neighbour<D>(P, G, NeighbourList{}, prm, b, P.position[b], [&](std::uint32_t i, const Vec<D>& rbi, Real r2) {
+        if (!in_system<D>(diag, i)) return;  // not an implicit fluid particle
         const Real h_i = UniformH ? prm.smoothing_length : P.smoothing_length[i];
         const Real h = pair_h<D, K>(P, prm, UniformH, h_i, b);
         if (!UniformH && r2 >= Real(4) * h * h) return;
-        const Real mu_i = P.effective_viscosity ? P.effective_viscosity[i] : prm.materials[P.material[i]].dynamic_viscosity;
+        const MaterialParams& Mi = prm.materials[P.material[i]];
+        const Real mu_i = P.effective_viscosity ? P.effective_viscosity[i] : Mi.dynamic_viscosity;
         const Real F = K::f_inv(std::sqrt(r2), Real(1) / h);
-        const Real s = pair::laminar_viscosity(P.mass[b], mu_i, mu_i, P.density[i], P.density[b], r2, kEta2Factor * h * h, F);
-        f -= (P.mass[i] * s) * (x[i] - vb);
+        const pair::ViscousPair<D> T = pair::viscous_pair<D>(central_stress_pair(Mi, Mi, false), P.mass[b], mu_i, mu_i,
+                                                             P.density[i], P.density[b], r2, kEta2Factor * h * h, F,
+                                                             Real(-1) * rbi);
+        f -= P.mass[i] * T.apply(x[i] - vb);
       });
     }
-    reaction[b] += share * f;
+    if (first_half) P.viscous_load[b] = P.viscous_pending[b] + share * f;
+    else P.viscous_pending[b] = share * f;
   }
 };
 

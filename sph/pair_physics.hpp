@@ -78,4 +78,44 @@ TURBID_HD inline Real laminar_viscosity(Real m_j, Real mu_i, Real mu_j, Real rho
   return m_j * pair_viscosity_sum(mu_i, mu_j) * F * r2 / (rho_i * rho_j * (r2 + eta2));
 }
 
+// The laminar viscous term of one pair as an operator on the relative velocity v_ij: a_i += apply(v_ij).
+//  - Laplacian form (Morris et al. 1997): apply(v) = s v with s = laminar_viscosity(...), the SPH
+//    form of div(mu grad v).
+//  - Central form: apply(v) = k (r_ij . v) r_ij with k = (D + 2) m_j 2 mu_ij F / (rho_i rho_j
+//    (r^2 + eta^2)), a pair force along r_ij (the central member of Espanol & Revenga's 2003
+//    family). With the kernel's isotropic fourth moment its continuum limit is the divergence of
+//      mu (grad v + grad v^T) + mu (div v) I,
+//    the full deviatoric stress 2 mu D' plus a bulk viscosity zeta = (1 + 2/D) mu; it conserves
+//    angular momentum and gives a rigid rotation no force. On a lattice the fourth moment is not
+//    isotropic: a shear along a lattice axis sees a viscosity 5% (h = 2 dx) to 20% (h = 1.3 dx)
+//    low (docs/choices.md), which is why it is not the default.
+// Both are symmetric in i, j and negative semidefinite (s <= 0, k <= 0), which the implicit update
+// (sph/implicit_viscosity.hpp) relies on; diagonal() is the pair's contribution to d a_i / d v_i.
+template <int D>
+struct ViscousPair {
+  Real k = 0;
+  Vec<D> r = Vec<D>::zero();
+  bool central = false;
+  TURBID_HD Vec<D> apply(const Vec<D>& v) const { return central ? (k * dot(r, v)) * r : k * v; }
+  TURBID_HD Vec<D> diagonal() const {
+    Vec<D> d;
+    for (int a = 0; a < D; ++a) d[a] = central ? k * r[a] * r[a] : k;
+    return d;
+  }
+};
+
+template <int D>
+TURBID_HD inline ViscousPair<D> viscous_pair(bool central, Real m_j, Real mu_i, Real mu_j, Real rho_i, Real rho_j,
+                                             Real r2, Real eta2, Real F, const Vec<D>& rij) {
+  ViscousPair<D> p;
+  p.central = central;
+  if (central) {
+    p.k = Real(D + 2) * m_j * pair_viscosity_sum(mu_i, mu_j) * F / (rho_i * rho_j * (r2 + eta2));
+    p.r = rij;
+  } else {
+    p.k = laminar_viscosity(m_j, mu_i, mu_j, rho_i, rho_j, r2, eta2, F);
+  }
+  return p;
+}
+
 }  // namespace turbid::sph::pair

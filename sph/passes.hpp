@@ -43,7 +43,8 @@ struct ParticleView {
   Real* effective_viscosity = nullptr; // only with a non-Newtonian material: mu_eff [Pa s]
   Real* shear_stress = nullptr;        // only with a non-Newtonian material: sqrt(J2(tau)) = mu_eff gamma_dot [Pa]
   std::uint8_t* split_fresh = nullptr; // only with transitions: 1 for the daughters of the last split
-  Vec<D>* viscous_reaction = nullptr;  // only with structures and implicit viscosity: see implicit_viscosity.hpp
+  Vec<D>* viscous_load = nullptr;     // only with structures and implicit viscosity: see implicit_viscosity.hpp
+  Vec<D>* viscous_pending = nullptr;
   // CPU only: positions as one array per coordinate (component a at a * soa_stride), a copy made
   // at each sort so that distance checks vectorise; valid until the next drift.
   const Real* position_soa = nullptr;
@@ -592,6 +593,12 @@ TURBID_HD inline bool implicit_pair(const MaterialParams& Mi, const MaterialPara
   return Mi.implicit_viscosity && (!fluid_j || Mj.implicit_viscosity);
 }
 
+// Whether the laminar viscous term of fluid particle i with j takes the central form (see
+// MaterialParams::central_stress); symmetric in i and j for two fluid particles.
+TURBID_HD inline bool central_stress_pair(const MaterialParams& Mi, const MaterialParams& Mj, bool fluid_j) {
+  return Mi.central_stress || (fluid_j && Mj.central_stress);
+}
+
 // Acceleration of fluid particle i (velocity vi, density rho_i, pressure p_i, smoothing length
 // h_i, material Mi, viscosity mu_i) due to particle j at r_ij = x_i - x_j: pressure and viscosity
 // (physics.md C10, C2). Boundary particles take the fluid's viscosity mu_i (no-slip in the fluid's
@@ -622,7 +629,9 @@ TURBID_HD inline Vec<D> momentum_pair(const ParticleView<D>& P, const PhysicsPar
   // update has them (sph/implicit_viscosity.hpp).
   if (implicit_pair(Mi, Mj, fluid_j)) return s * rij;
   const Real mu_j = !fluid_j ? mu_i : (P.effective_viscosity ? P.effective_viscosity[j] : Mj.dynamic_viscosity);
-  return s * rij + pair::laminar_viscosity(m_j, mu_i, mu_j, rho_i, rho_j, r2, eta2, F) * vij;
+  return s * rij +
+         pair::viscous_pair<D>(central_stress_pair(Mi, Mj, fluid_j), m_j, mu_i, mu_j, rho_i, rho_j, r2, eta2, F, rij)
+             .apply(vij);
 }
 
 // Momentum (pressure gradient, viscosity, gravity) for fluid particles; walls get zero.

@@ -55,6 +55,10 @@ struct MaterialParams {
   // Its laminar viscous terms (between two of its particles, and with boundary particles) are
   // integrated implicitly (sph/implicit_viscosity.hpp), the others explicitly in the momentum pass.
   bool implicit_viscosity = false;
+  // Its laminar viscous terms take the central pair form (pair::ViscousPair: the divergence of
+  // mu (grad v + grad v^T) + mu (div v) I), else Morris' Laplacian form div(mu grad v). A pair of
+  // two materials takes the central form if either has it; a pair with a boundary particle, the fluid's.
+  bool central_stress = false;
   // Smallest h among this material's particles [m], for its time-step limits; 0: the lattice's h.
   // Splitting lowers it for the materials daughters are made of.
   Real min_smoothing_length = 0;

@@ -84,8 +84,10 @@ class Solver {
   // Wall time spent splitting (flag, insertion, relaxation, rebuild) and in whole steps since the
   // start of this process's run [s]; measured only with transitions.
   double split_seconds() const { return split_seconds_; }
-  // Implicit viscosity: conjugate-gradient iterations over the run, the most in one step, and the
-  // steps that stopped at the iteration limit above the tolerance.
+  // Implicit viscosity, since this process started: the solves (two per step), their
+  // conjugate-gradient iterations, the most in one solve, and the solves that stopped at the
+  // iteration limit above the tolerance.
+  std::uint64_t viscous_solves() const { return viscous_solves_; }
   std::uint64_t viscous_iterations() const { return viscous_iterations_; }
   int viscous_iterations_max() const { return viscous_iterations_max_; }
   std::uint64_t viscous_unconverged() const { return viscous_unconverged_; }
@@ -113,9 +115,9 @@ class Solver {
   SplitParams split_;
   bool split_error_when_full_ = false;
   SplitCounts split_totals_;
-  void solve_viscosity(double dt);
+  void solve_viscosity(double dt, bool first_half);
   double split_seconds_ = 0;  // wall time in split() (with transitions only) [s]
-  std::uint64_t viscous_iterations_ = 0, viscous_unconverged_ = 0;
+  std::uint64_t viscous_solves_ = 0, viscous_iterations_ = 0, viscous_unconverged_ = 0;
   int viscous_iterations_max_ = 0;
   double step_seconds_ = 0;   // wall time of the steps, split included (with transitions only) [s]
   double time_ = 0;

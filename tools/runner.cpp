@@ -411,8 +411,13 @@ std::string describe_scene(const fsi::Scene& scene) {
     const auto& mat = scene.materials[m];
     os << "  material " << mat.name << ": " << s.particles_per_material[m] << " particles, sound speed "
        << s.sound_speed[m] << " m/s, " << mat.model;
+    const bool laminar = scene.numerics.viscosity == fsi::ViscosityKind::laminar;
+    const std::string terms = std::string(params.materials[m].implicit_viscosity ? "implicit" : "explicit") +
+                              (params.materials[m].central_stress ? ", central pair form" : ", Laplacian form");
     if (mat.model == "newtonian") {
-      os << ", viscosity " << mat.viscosity << " Pa s\n";
+      os << ", viscosity " << mat.viscosity << " Pa s";
+      if (laminar && mat.viscosity > 0) os << ", viscous terms " << terms;
+      os << "\n";
       continue;
     }
     os << " (yield stress " << mat.yield_stress << " Pa, "
@@ -423,7 +428,7 @@ std::string describe_scene(const fsi::Scene& scene) {
     if (mat.max_viscosity > 0) os << "effective viscosity capped at " << mat.max_viscosity << " Pa s (stated)";
     else if (std::isfinite(bound)) os << "largest effective viscosity " << bound << " Pa s (at rest)";
     else os << "effective viscosity unbounded (power law)";
-    os << ", viscous terms " << (params.materials[m].implicit_viscosity ? "implicit" : "explicit") << "\n";
+    os << ", viscous terms " << terms << "\n";
   }
   os << "domain           [" << s.domain.min[0] << ", " << s.domain.max[0] << "] x [" << s.domain.min[1] << ", "
      << s.domain.max[1] << "]";
@@ -570,11 +575,14 @@ nlohmann::json run_scene(const RunRequest& request) {
     report["split_share_of_step_time"] = sim.step_seconds() > 0 ? sim.split_seconds() / sim.step_seconds() : 0.0;
   }
   if (sim.params().implicit_viscosity) {
-    // Implicit viscosity (sph/implicit_viscosity.hpp): conjugate-gradient iterations, this process.
+    // Implicit viscosity (sph/implicit_viscosity.hpp): conjugate-gradient iterations per solve (two
+    // solves per step), this process only (a resumed run counts from the resume).
     const auto& sv = sim.solver();
-    report["viscous_iterations_mean"] = sim.steps() > 0 ? double(sv.viscous_iterations()) / double(sim.steps()) : 0.0;
-    report["viscous_iterations_max"] = sv.viscous_iterations_max();
-    report["viscous_unconverged_steps"] = sv.viscous_unconverged();
+    report["viscous_solves"] = sv.viscous_solves();
+    report["viscous_iterations_mean_per_solve"] =
+        sv.viscous_solves() > 0 ? double(sv.viscous_iterations()) / double(sv.viscous_solves()) : 0.0;
+    report["viscous_iterations_max_per_solve"] = sv.viscous_iterations_max();
+    report["viscous_unconverged_solves"] = sv.viscous_unconverged();
   }
   report["steps"] = sim.steps();
   report["simulated_time"] = sim.time();

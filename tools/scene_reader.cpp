@@ -584,7 +584,7 @@ void Reader::read_numerics(const Value& v, fsi::NumericsSpec& n) const {
     }
   }
   if (auto vv = m.get("viscosity")) {
-    MapView visc(*this, *vv, {"type", "alpha", "integration"});
+    MapView visc(*this, *vv, {"type", "alpha", "integration", "stress"});
     if (auto t = visc.get("type"))
       n.viscosity = choice(*t, {"artificial", "laminar"}) == 0 ? fsi::ViscosityKind::artificial
                                                                : fsi::ViscosityKind::laminar;
@@ -600,6 +600,12 @@ void Reader::read_numerics(const Value& v, fsi::NumericsSpec& n) const {
       const int k = choice(*integ, {"auto", "explicit", "implicit"});
       n.viscous_integration = k == 0 ? fsi::ViscousIntegration::automatic
                                      : (k == 1 ? fsi::ViscousIntegration::explicit_ : fsi::ViscousIntegration::implicit);
+    }
+    if (auto st = visc.get("stress")) {
+      if (n.viscosity != fsi::ViscosityKind::laminar)
+        fail(visc.key_mark("stress"), "'stress' applies only to 'laminar' viscosity");
+      n.viscous_stress = choice(*st, {"laplacian", "central"}) == 0 ? fsi::ViscousStress::laplacian
+                                                                    : fsi::ViscousStress::central;
     }
   }
   if (auto sv = m.get("shifting")) {

@@ -253,3 +253,34 @@ TEST(CheckpointResume, ResumedRunThroughSplittingIsBitIdentical) {
   EXPECT_EQ(r.resumed.at("capacity").get<std::size_t>(),
             std::size_t(std::ceil(3.0 * double(r.resumed.at("particles").get<std::size_t>()))));
 }
+
+// Implicit viscosity (issue #20): a Bingham column (no stated cap, so its viscosity at rest,
+// m tau_y + mu_p = 2000 Pa s, is integrated implicitly, in the full-stress form) collapsing in a
+// tank with no-slip mDBC walls, against a fixed structure. The next step's first viscous solve reads
+// the mirrored wall velocities and the effective viscosities of the last force pass, and the
+// structure's viscous load waits half a step in viscous_pending: the checkpoint must hold them all.
+TEST(CheckpointResume, ResumedRunWithImplicitViscosityAndMdbcIsBitIdentical) {
+  const auto r = check_resume(R"(name: resume_implicit_viscosity
+dimensions: 2
+resolution: {particle_spacing: 0.01, smoothing_ratio: 1.3}
+time: {end: 0.06, cfl: 0.2}
+gravity: [0, -9.81]
+numerics:
+  viscosity: {type: laminar, integration: auto}
+  boundary: {type: mdbc, velocity: no_slip}
+materials:
+  debris: {model: bingham, density: 1800, viscosity: 0.5, yield_stress: 20, papanastasiou_exponent: 100,
+           sound_speed: 20}
+walls:
+  - box: {min: [0, 0], max: [0.4, 0.25]}
+structures:
+  - {name: block, box: {size: [0.04, 0.04]}, position: [0.2, 0.03]}
+fluids:
+  - {material: debris, box: {min: [0, 0], max: [0.12, 0.2]}}
+probes:
+  - {name: front, type: front_position, material: debris, axis: x}
+output: {every: 0.01, vtk: true}
+)");
+  EXPECT_EQ(r.full.at("status"), "completed");
+  EXPECT_GT(r.full.at("viscous_solves").get<long>(), 0) << "the implicit solve must run";
+}

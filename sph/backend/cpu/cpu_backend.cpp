@@ -123,8 +123,9 @@ class CpuBackend final : public Backend {
   }
 
   bool supports_implicit_viscosity() const override { return true; }
-  ViscousSolve solve_viscosity(double dt, double share) override {
-    return params_.dimensions == 2 ? viscosity_impl<2>(Real(dt), Real(share)) : viscosity_impl<3>(Real(dt), Real(share));
+  ViscousSolve solve_viscosity(double dt, double share, bool first_half) override {
+    return params_.dimensions == 2 ? viscosity_impl<2>(Real(dt), Real(share), first_half)
+                                   : viscosity_impl<3>(Real(dt), Real(share), first_half);
   }
 
   // Sum over particles of f(i) in double, in blocks of fixed size added in order: the same bits
@@ -150,7 +151,7 @@ class CpuBackend final : public Backend {
   // sph/implicit_viscosity.hpp), in the inner product weighted by particle mass, in which the
   // system is symmetric; starts from the current velocities.
   template <int D>
-  ViscousSolve viscosity_impl(Real dt, Real share) {
+  ViscousSolve viscosity_impl(Real dt, Real share, bool first_half) {
     const ParticleView<D> P = view<D>();
     const GridView<D> G = grid<D>();
     const std::uint32_t n = P.count;
@@ -161,13 +162,16 @@ class CpuBackend final : public Backend {
     std::vector<Vec<D>>& z = cg_[2];
     std::vector<Vec<D>>& p = cg_[3];
     std::vector<Vec<D>>& q = cg_[4];
-    for (int k = 0; k < 5; ++k) cg_[k].resize(n);
-    cg_diag_.resize(n);
-    Real* diag = cg_diag_.data();
+    for (int k = 0; k < 6; ++k) cg_[k].resize(n);
+    Vec<D>* diag = cg_[5].data();
+    // z = r / diag, component by component (the Jacobi preconditioner)
+    const auto precondition = [&](std::uint32_t i) {
+      for (int c = 0; c < D; ++c) z[i][c] = r[i][c] / diag[i][c];
+    };
     const NeighbourList L = list(false);
     const auto dot = [&](const std::vector<Vec<D>>& a, const std::vector<Vec<D>>& b) {
       return fixed_order_sum(n, [&](std::uint32_t i) {
-        return diag[i] == Real(0) ? 0.0 : double(P.mass[i]) * double(turbid::sph::dot(a[i], b[i]));
+        return in_system<D>(diag, i) ? double(P.mass[i]) * double(turbid::sph::dot(a[i], b[i])) : 0.0;
       });
     };
     dispatch_kernel<D>(params_, [&](auto kernel_tag, auto uniform_tag) {
@@ -178,8 +182,12 @@ class CpuBackend final : public Backend {
       parallel_for(n, ViscousApplyPass<D, K, U>{P, G, params_, L, dt, diag, x.data(), q.data()});
       const double b_norm = std::sqrt(dot(r, r));
       parallel_for(n, [&](std::uint32_t i) {
-        r[i] = diag[i] == Real(0) ? Vec<D>::zero() : r[i] - q[i];
-        z[i] = diag[i] == Real(0) ? Vec<D>::zero() : (Real(1) / diag[i]) * r[i];
+        if (in_system<D>(diag, i)) {
+          r[i] -= q[i];
+          precondition(i);
+        } else {
+          r[i] = z[i] = Vec<D>::zero();
+        }
         p[i] = z[i];
       });
       double rz = dot(r, z);
@@ -192,10 +200,10 @@ class CpuBackend final : public Backend {
         if (!(pq > 0)) break;
         const Real alpha = Real(rz / pq);
         parallel_for(n, [&](std::uint32_t i) {
-          if (diag[i] == Real(0)) return;
+          if (!in_system<D>(diag, i)) return;
           x[i] += alpha * p[i];
           r[i] -= alpha * q[i];
-          z[i] = (Real(1) / diag[i]) * r[i];
+          precondition(i);
         });
         ++k;
         res = std::sqrt(dot(r, r)) / b_norm;
@@ -203,15 +211,15 @@ class CpuBackend final : public Backend {
         const Real beta = Real(rz_next / rz);
         rz = rz_next;
         parallel_for(n, [&](std::uint32_t i) {
-          if (diag[i] != Real(0)) p[i] = z[i] + beta * p[i];
+          if (in_system<D>(diag, i)) p[i] = z[i] + beta * p[i];
         });
       }
       out.iterations = k;
       out.residual = res;
       out.converged = res <= tol;
       parallel_for(n, ViscousUpdatePass<D, K, U>{P, G, params_, L, dt, diag, x.data()});
-      if (P.viscous_reaction)
-        parallel_for(n, ViscousReactionPass<D, K, U>{P, G, params_, diag, x.data(), P.viscous_reaction, share});
+      if (P.viscous_load)
+        parallel_for(n, ViscousReactionPass<D, K, U>{P, G, params_, diag, x.data(), share, first_half});
     });
     return out;
   }
@@ -363,7 +371,8 @@ class CpuBackend final : public Backend {
     if (ids_.effective_viscosity >= 0) v.effective_viscosity = s.data<Real>(ids_.effective_viscosity);
     if (ids_.shear_stress >= 0) v.shear_stress = s.data<Real>(ids_.shear_stress);
     if (ids_.split_fresh >= 0) v.split_fresh = s.data<std::uint8_t>(ids_.split_fresh);
-    if (ids_.viscous_reaction >= 0) v.viscous_reaction = s.data<Vec<D>>(ids_.viscous_reaction);
+    if (ids_.viscous_load >= 0) v.viscous_load = s.data<Vec<D>>(ids_.viscous_load);
+    if (ids_.viscous_pending >= 0) v.viscous_pending = s.data<Vec<D>>(ids_.viscous_pending);
     v.count = std::uint32_t(s.size());
     if (soa_valid_) {
       v.position_soa = soa_.data();
@@ -596,9 +605,8 @@ class CpuBackend final : public Backend {
   std::vector<Real> soa_;
   // Implicit viscosity: the conjugate-gradient vectors (x, r, z, p, A p) per dimension, the
   // diagonal, and the block sums of the fixed-order reductions.
-  std::vector<Vec<2>> cg2_[5];
-  std::vector<Vec<3>> cg3_[5];
-  std::vector<Real> cg_diag_;
+  std::vector<Vec<2>> cg2_[6];  // x, r, z, p, q and the diagonal of the implicit viscous CG
+  std::vector<Vec<3>> cg3_[6];
   std::vector<double> block_sums_;
   template <int D>
   std::vector<Vec<D>>* cg_vectors() {
