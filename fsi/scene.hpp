@@ -26,10 +26,12 @@ enum class ViscosityKind { artificial, laminar };
 // whose largest viscosity would put the explicit viscous limit below the acoustic one, explicitly
 // otherwise; explicit or implicit: every material that way (docs/choices.md).
 enum class ViscousIntegration { automatic, explicit_, implicit };
-// The laminar viscous pair term (sph::pair::ViscousPair, docs/choices.md): Morris' Laplacian form
-// div(mu grad v) (the default), or the central pair form, whose limit is the divergence of
-// mu (grad v + grad v^T) + mu (div v) I (full stress plus a bulk viscosity).
-enum class ViscousStress { laplacian, central };
+// The laminar viscous stress (docs/choices.md): auto, the full deviatoric stress 2 mu D'
+// (sph/full_stress.hpp, integrated implicitly) for non-Newtonian materials integrated implicitly,
+// Morris' Laplacian form div(mu grad v) for the others; full: every material the full stress (and
+// so implicit); laplacian; or the central pair form (sph::pair::ViscousPair), whose limit is the
+// divergence of mu (grad v + grad v^T) + mu (div v) I.
+enum class ViscousStress { automatic, laplacian, central, full };
 enum class BoundaryKind { dbc, mdbc };  // wall treatment; see docs/choices.md
 
 // A material's rheology (physics.md C8): newtonian (viscosity), bingham (yield_stress and the
@@ -271,7 +273,7 @@ struct NumericsSpec {
   ViscosityKind viscosity = ViscosityKind::artificial;
   double artificial_viscosity = 0.01;      // Monaghan alpha [-]
   ViscousIntegration viscous_integration = ViscousIntegration::automatic;
-  ViscousStress viscous_stress = ViscousStress::laplacian;
+  ViscousStress viscous_stress = ViscousStress::automatic;
   double cfl = 0.2;                        // Courant number for the acoustic and force limits [-]
   double viscous_dt_factor = 0.125;        // dt <= factor h^2 / nu_max (Morris et al. 1997)
   double min_time_step = 1.0e-9;           // a smaller dt stops the run as collapsed [s]

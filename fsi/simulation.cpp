@@ -488,6 +488,22 @@ sph::PhysicsParams physics_params(const Scene& scene) {
       p.materials[m].non_newtonian = true;
       p.rheology = true;
     }
+    // The viscous stress (docs/choices.md): the full deviatoric stress lives in the implicit update.
+    const ViscousStress stress = scene.numerics.viscous_stress;
+    const bool full = laminar && ms.viscosity + ms.consistency + ms.yield_stress > 0 &&
+                      (stress == ViscousStress::full ||
+                       (stress == ViscousStress::automatic && p.materials[m].non_newtonian &&
+                        p.materials[m].implicit_viscosity));
+    if (full && scene.numerics.viscous_integration == ViscousIntegration::explicit_)
+      throw std::invalid_argument(material_error(ms) +
+                                  "the full viscous stress ('stress: full') is integrated implicitly; use "
+                                  "'integration: auto' or 'implicit', or 'stress: laplacian' with explicit integration");
+    if (full) {
+      p.materials[m].full_stress = true;
+      p.materials[m].implicit_viscosity = true;
+      p.implicit_viscosity = true;
+      p.full_stress = true;
+    }
   }
   if (!scene.transitions.empty()) {
     // The criterion reads every fluid particle's effective shear stress, and daughters have half

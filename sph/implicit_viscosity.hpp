@@ -27,6 +27,7 @@
 #include <cstdint>
 
 #include "sph/config.hpp"
+#include "sph/full_stress.hpp"
 #include "sph/pair_physics.hpp"
 #include "sph/passes.hpp"
 
@@ -38,7 +39,8 @@ TURBID_HD inline bool in_viscous_system(const ParticleView<D>& P, const PhysicsP
   return P.kind[i] == std::uint8_t(Kind::fluid) && prm.materials[P.material[i]].implicit_viscosity;
 }
 
-// Calls f(j, T_ij, boundary_j) for every implicit pair of system particle i (see above).
+// Calls f(j, T_ij, boundary_j) for every implicit pair of system particle i in the pair form (see
+// above); the pairs of a full-stress particle with F(i) are left to full_stress.hpp.
 template <int D, class K, bool UniformH, class Visit>
 TURBID_HD inline void for_each_implicit_pair(const ParticleView<D>& P, const GridView<D>& G, const NeighbourList& L,
                                              const PhysicsParams& prm, std::uint32_t i, Visit&& f) {
@@ -47,6 +49,7 @@ TURBID_HD inline void for_each_implicit_pair(const ParticleView<D>& P, const Gri
   const Real h_i = UniformH ? prm.smoothing_length : P.smoothing_length[i];
   const MaterialParams& Mi = prm.materials[P.material[i]];
   const Real mu_i = P.effective_viscosity ? P.effective_viscosity[i] : Mi.dynamic_viscosity;
+  const bool full_i = full_stress_particle<D>(P, prm, i);
   for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
     const Real h = pair_h<D, K>(P, prm, UniformH, h_i, j);
     if (!UniformH && r2 >= Real(4) * h * h) return;
@@ -54,6 +57,7 @@ TURBID_HD inline void for_each_implicit_pair(const ParticleView<D>& P, const Gri
     if (!fluid_j && P.free_slip && P.free_slip[j]) return;  // a free-slip wall exerts no shear
     const MaterialParams& Mj = prm.materials[fluid_j ? int(P.material[j]) : prm.wall_material];
     if (!implicit_pair(Mi, Mj, fluid_j)) return;
+    if (full_i && full_stress_neighbour<D>(P, prm, j)) return;  // in the full-stress form (full_stress.hpp)
     const Real mu_j = !fluid_j ? mu_i : (P.effective_viscosity ? P.effective_viscosity[j] : Mj.dynamic_viscosity);
     const Real F = K::f_inv(std::sqrt(r2), Real(1) / h);
     f(j,
@@ -93,6 +97,17 @@ struct ViscousSystemPass {
       sum += T.diagonal();
       if (boundary) known += T.apply(viscous_velocity_of<D>(P, j));
     });
+    // The full-stress part's diagonal, estimated as twice Morris' (stress and pair residual terms):
+    // a preconditioner needs only be positive.
+    if (full_stress_particle<D>(P, prm, i)) {
+      Real c_sum = 0;
+      const Real mu_i = P.effective_viscosity ? P.effective_viscosity[i] : prm.materials[P.material[i]].dynamic_viscosity;
+      for_each_full_stress_neighbour<D, K, UniformH>(P, G, L, prm, i, [&](std::uint32_t j, const Vec<D>& rij, Real F, Real h, bool) {
+        const Real r2 = dot(rij, rij);
+        c_sum += P.mass[j] / P.density[j] * (-F) * r2 / (r2 + kEta2Factor * h * h);
+      });
+      for (int a = 0; a < D; ++a) sum[a] -= Real(4) * mu_i * c_sum / P.density[i];
+    }
     Vec<D> d;
     for (int a = 0; a < D; ++a) d[a] = Real(1) - dt * sum[a];
     diag[i] = d;
@@ -100,8 +115,10 @@ struct ViscousSystemPass {
   }
 };
 
-// out_i = (A x)_i = x_i - dt sum_j T_ij (x_i - x_j) + dt sum_boundary T_ij v_j, i.e. A x without
-// the known boundary velocities, for system particles; 0 for the others.
+// out_i = (A x)_i = x_i - dt sum_j T_ij (x_i - x_j) + dt sum_boundary T_ij v_j - dt a^full_i(x), i.e.
+// A x without the known boundary velocities, for system particles; 0 for the others. a^full: the
+// full-stress acceleration -dR/du / m of x with the boundary velocities left out (full: dR/du; null:
+// none).
 template <int D, class K, bool UniformH>
 struct ViscousApplyPass {
   ParticleView<D> P;
@@ -111,6 +128,7 @@ struct ViscousApplyPass {
   Real dt;
   const Vec<D>* diag;
   const Vec<D>* x;
+  const Vec<D>* full;
   Vec<D>* out;
 
   TURBID_HD void operator()(std::uint32_t i) const {
@@ -123,12 +141,14 @@ struct ViscousApplyPass {
     for_each_implicit_pair<D, K, UniformH>(P, G, L, prm, i, [&](std::uint32_t j, const pair::ViscousPair<D>& T, bool boundary) {
       a += T.apply(boundary ? xi : xi - x[j]);
     });
+    if (full) a -= (Real(1) / P.mass[i]) * full[i];
     out[i] = xi - dt * a;
   }
 };
 
-// The update: v_i = v*_i + dt sum_j T_ij (x_i - x_j) for system particles (boundary j with the
-// velocity they show viscous terms). Reads x and boundary velocities, writes fluid velocities.
+// The update: v_i = v*_i + dt [sum_j T_ij (x_i - x_j) + a^full_i(x)] for system particles (boundary
+// j with the velocity they show viscous terms; a^full with them). Reads x and boundary velocities,
+// writes fluid velocities.
 template <int D, class K, bool UniformH>
 struct ViscousUpdatePass {
   ParticleView<D> P;
@@ -138,6 +158,7 @@ struct ViscousUpdatePass {
   Real dt;
   const Vec<D>* diag;
   const Vec<D>* x;
+  const Vec<D>* full;
 
   TURBID_HD void operator()(std::uint32_t i) const {
     if (!in_system<D>(diag, i)) return;
@@ -146,6 +167,7 @@ struct ViscousUpdatePass {
     for_each_implicit_pair<D, K, UniformH>(P, G, L, prm, i, [&](std::uint32_t j, const pair::ViscousPair<D>& T, bool boundary) {
       a += T.apply(xi - (boundary ? viscous_velocity_of<D>(P, j) : x[j]));
     });
+    if (full) a -= (Real(1) / P.mass[i]) * full[i];
     P.velocity[i] += dt * a;
   }
 };
@@ -166,6 +188,7 @@ struct ViscousReactionPass {
   const Vec<D>* x;
   Real share;        // this update's share of the fluid step (its dt / the step's dt)
   bool first_half;   // the step's first update (else its second)
+  const Vec<D>* full_dR = nullptr;  // dR/du of the full-stress evaluation at x (null: none)
 
   TURBID_HD void operator()(std::uint32_t b) const {
     Vec<D> f = Vec<D>::zero();
@@ -175,6 +198,7 @@ struct ViscousReactionPass {
       const Vec<D> vb = viscous_velocity_of<D>(P, b);
       for_each_neighbour<D>(P, G, NeighbourList{}, prm, b, P.position[b], [&](std::uint32_t i, const Vec<D>& rbi, Real r2) {
         if (!in_system<D>(diag, i)) return;  // not an implicit fluid particle
+        if (full_stress_particle<D>(P, prm, i)) return;  // its pair with b is in the full-stress form
         const Real h_i = UniformH ? prm.smoothing_length : P.smoothing_length[i];
         const Real h = pair_h<D, K>(P, prm, UniformH, h_i, b);
         if (!UniformH && r2 >= Real(4) * h * h) return;
@@ -187,6 +211,7 @@ struct ViscousReactionPass {
         f -= P.mass[i] * T.apply(x[i] - vb);
       });
     }
+    if (full_dR && P.kind[b] == std::uint8_t(Kind::structure)) f -= full_dR[b];
     if (first_half) P.viscous_load[b] = P.viscous_pending[b] + share * f;
     else P.viscous_pending[b] = share * f;
   }

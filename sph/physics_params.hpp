@@ -59,6 +59,9 @@ struct MaterialParams {
   // mu (grad v + grad v^T) + mu (div v) I), else Morris' Laplacian form div(mu grad v). A pair of
   // two materials takes the central form if either has it; a pair with a boundary particle, the fluid's.
   bool central_stress = false;
+  // Its own pairs and its pairs with boundary particles take the full deviatoric stress
+  // (sph/full_stress.hpp) in the implicit update; needs implicit_viscosity.
+  bool full_stress = false;
   // Smallest h among this material's particles [m], for its time-step limits; 0: the lattice's h.
   // Splitting lowers it for the materials daughters are made of.
   Real min_smoothing_length = 0;
@@ -111,6 +114,7 @@ struct PhysicsParams {
   // step (conjugate gradients to a relative residual of implicit_tolerance, at most
   // implicit_max_iterations iterations).
   bool implicit_viscosity = false;
+  bool full_stress = false;  // some material has MaterialParams::full_stress
   Real implicit_tolerance = Real(1e-5);
   int implicit_max_iterations = 500;
   int material_count = 0;

@@ -413,7 +413,9 @@ std::string describe_scene(const fsi::Scene& scene) {
        << s.sound_speed[m] << " m/s, " << mat.model;
     const bool laminar = scene.numerics.viscosity == fsi::ViscosityKind::laminar;
     const std::string terms = std::string(params.materials[m].implicit_viscosity ? "implicit" : "explicit") +
-                              (params.materials[m].central_stress ? ", central pair form" : ", Laplacian form");
+                              (params.materials[m].full_stress      ? ", full stress"
+                               : params.materials[m].central_stress ? ", central pair form"
+                                                                    : ", Laplacian form");
     if (mat.model == "newtonian") {
       os << ", viscosity " << mat.viscosity << " Pa s";
       if (laminar && mat.viscosity > 0) os << ", viscous terms " << terms;

@@ -604,8 +604,9 @@ void Reader::read_numerics(const Value& v, fsi::NumericsSpec& n) const {
     if (auto st = visc.get("stress")) {
       if (n.viscosity != fsi::ViscosityKind::laminar)
         fail(visc.key_mark("stress"), "'stress' applies only to 'laminar' viscosity");
-      n.viscous_stress = choice(*st, {"laplacian", "central"}) == 0 ? fsi::ViscousStress::laplacian
-                                                                    : fsi::ViscousStress::central;
+      const fsi::ViscousStress kinds[] = {fsi::ViscousStress::automatic, fsi::ViscousStress::full,
+                                          fsi::ViscousStress::laplacian, fsi::ViscousStress::central};
+      n.viscous_stress = kinds[choice(*st, {"auto", "full", "laplacian", "central"})];
     }
   }
   if (auto sv = m.get("shifting")) {

@@ -121,14 +121,14 @@ output: {every: 0.01, vtk: true}
 }
 
 // Implicit viscosity (sph/implicit_viscosity.hpp): a Bingham column with no stated cap (viscosity at
-// rest m tau_y + mu_p = 2000 Pa s, integrated implicitly in the full-stress form) against a fixed
+// rest m tau_y + mu_p = 2000 Pa s, integrated implicitly with the full stress, sph/full_stress.hpp) against a fixed
 // structure, with no-slip mDBC walls: the conjugate-gradient solve (its inner products are summed in
 // fixed blocks), the viscous load on the structure and forces.csv must give the same bits.
 TEST(Determinism, ImplicitViscositySolveIsBitIdenticalOnOneAndTwoThreads) {
   const int frames = expect_same_bits_on_1_and_2_threads("implicit_viscosity", R"(name: determinism_implicit
 dimensions: 2
 resolution: {particle_spacing: 0.004, smoothing_ratio: 2.0}
-time: {end: 0.02, cfl: 0.2}
+time: {end: 0.008, cfl: 0.2}
 gravity: [0, -9.81]
 numerics:
   density_diffusion: {type: fourtakas, delta: 0.1}
@@ -145,7 +145,7 @@ fluids:
   - {material: debris, box: {min: [0, 0], max: [0.25, 0.2]}}
 probes:
   - {name: front, type: front_position, material: debris, axis: x}
-output: {every: 0.005, vtk: true, forces_every: 0.002}
+output: {every: 0.002, vtk: true, forces_every: 0.001}
 )");
   EXPECT_GE(frames, 4);
 }

@@ -23,6 +23,7 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "fsi/scene.hpp"
 #include "fsi/simulation.hpp"

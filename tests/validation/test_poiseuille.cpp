@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -155,9 +156,18 @@ void PrintTo(const SteadyCase& c, std::ostream* os) { *os << c.scene; }
 
 class ValidationPoiseuilleSteady : public ::testing::TestWithParam<SteadyCase> {};
 
-// Steady yield-stress profiles (physics.md D6) at H/dx = 10.
+// Steady yield-stress profiles (physics.md D6) at H/dx = 10; with TURBID_FULL=1 at H/dx = 20, where
+// the bounds apply (L2 error 2%, plug half-width 5%; the n = 0.5 plug, smoothed over much of
+// the plug at this spacing too, is reported, not asserted).
 TEST_P(ValidationPoiseuilleSteady, ProfileAndPlugMatchAnalyticSolution) {
-  const SteadyCase& c = GetParam();
+  SteadyCase c = GetParam();
+  if (turbid::validation::full_mode()) {
+    // TURBID_POISEUILLE_REFINE=4 runs H/dx = 40 (the convergence table of docs/validation.md D6).
+    const char* refine = std::getenv("TURBID_POISEUILLE_REFINE");
+    c.dx /= refine ? std::max(1, std::atoi(refine)) : 2;
+    c.tolerance = 0.02;
+    if (c.plug_tolerance > 0) c.plug_tolerance = 0.05;
+  }
   SCOPED_TRACE(std::string(c.scene) + ", measured " + c.measured);
   Scene s = poiseuille_scene(c.scene, c.dx);
   s.end_time = c.end;
@@ -189,13 +199,14 @@ TEST_P(ValidationPoiseuilleSteady, ProfileAndPlugMatchAnalyticSolution) {
 
 INSTANTIATE_TEST_SUITE_P(
     Rheology, ValidationPoiseuilleSteady,
-    // Measured at H/dx = 10 with the scenes' h = 1.5 dx: Bingham (2 s) L2 4.19%, plug -10.6%;
-    // n = 1.5 (3 s; at 2 s it is still 1% off its steady profile) L2 2.65%, plug +1.5%; n = 0.5
-    // (slowest to settle, 4 s) L2 7.75%, plug -46% (the plug edge is smoothed over much of the plug
-    // at this spacing, so only the profile is asserted here). Bounds: these with a margin.
-    ::testing::Values(SteadyCase{"poiseuille_bingham_2d", 0.001, 2.0, 0.05, 0.15, "L2 4.19%, plug -10.6%"},
-                      SteadyCase{"poiseuille_hb_thinning_2d", 0.001, 4.0, 0.09, -1.0, "L2 7.75%, plug -46%"},
-                      SteadyCase{"poiseuille_hb_thickening_2d", 0.001, 3.0, 0.035, 0.05, "L2 2.65%, plug +1.5%"}),
+    // Measured at H/dx = 10 with the scenes' h = 1.5 dx and the full stress (the default for these
+    // implicit materials, docs/validation.md D6): Bingham (2 s) L2 3.11%, plug +11.1%; n = 1.5 (3 s;
+    // at 2 s it is still 1% off its steady profile) L2 3.11%, plug +15.0%; n = 0.5 (slowest to
+    // settle, 4 s) L2 1.94%, plug +4.9%. Bounds: these with a margin. (With the Laplacian form, until
+    // 2026-12-03: 4.19% / -10.6%, 2.65% / +1.5%, 7.75% / -46%.)
+    ::testing::Values(SteadyCase{"poiseuille_bingham_2d", 0.001, 2.0, 0.04, 0.15, "L2 3.11%, plug +11.1%"},
+                      SteadyCase{"poiseuille_hb_thinning_2d", 0.001, 4.0, 0.03, 0.10, "L2 1.94%, plug +4.9%"},
+                      SteadyCase{"poiseuille_hb_thickening_2d", 0.001, 3.0, 0.04, 0.20, "L2 3.11%, plug +15.0%"}),
     [](const ::testing::TestParamInfo<SteadyCase>& info) {
       const std::string name = info.param.scene;
       return name.substr(11, name.size() - 14);  // poiseuille_<case>_2d -> <case>

@@ -162,8 +162,19 @@ class CpuBackend final : public Backend {
     std::vector<Vec<D>>& z = cg_[2];
     std::vector<Vec<D>>& p = cg_[3];
     std::vector<Vec<D>>& q = cg_[4];
-    for (int k = 0; k < 6; ++k) cg_[k].resize(n);
+    for (int k = 0; k < 8; ++k) cg_[k].resize(n);
     Vec<D>* diag = cg_[5].data();
+    // The full-stress form (sph/full_stress.hpp): renormalisation, gradient and Q per particle, the
+    // pair part of dR/du, and the acceleration of an evaluation.
+    const bool full = params_.full_stress;
+    std::vector<Mat<D>>* fs = full_stress_tensors<D>();
+    if (full) {
+      for (int k = 0; k < 3; ++k) fs[k].resize(n);
+      carrier_mu_.resize(n);
+    }
+    Vec<D>* direct = cg_[6].data();
+    Vec<D>* full_dR = full ? cg_[7].data() : nullptr;
+    Real* carrier = carrier_mu_.data();
     // z = r / diag, component by component (the Jacobi preconditioner)
     const auto precondition = [&](std::uint32_t i) {
       for (int c = 0; c < D; ++c) z[i][c] = r[i][c] / diag[i][c];
@@ -177,9 +188,28 @@ class CpuBackend final : public Backend {
     dispatch_kernel<D>(params_, [&](auto kernel_tag, auto uniform_tag) {
       using K = typename decltype(kernel_tag)::type;
       constexpr bool U = decltype(uniform_tag)::value;
+      // dR/du of the full-stress form (sph/full_stress.hpp) into full_dR; linear in (u, known):
+      // dR(x; known) = dR(x; 0) + dR(0; known).
+      const auto full_eval = [&](const Vec<D>* u, bool known, bool structures = false) {
+        parallel_for(n, FullStressGradientPass<D, K, U>{P, G, params_, L, u, known, carrier, fs[0].data(), fs[1].data()});
+        parallel_for(n, FullStressStressPass<D, K, U>{P, G, params_, L, u, known, carrier, fs[0].data(), fs[1].data(),
+                                                       fs[2].data(), direct});
+        parallel_for(n, FullStressForcePass<D, K, U>{P, G, params_, L, carrier, fs[2].data(), direct, structures, full_dR});
+      };
+      const auto apply = [&](const std::vector<Vec<D>>& u, std::vector<Vec<D>>& out) {
+        if (full) full_eval(u.data(), false);
+        parallel_for(n, ViscousApplyPass<D, K, U>{P, G, params_, L, dt, diag, u.data(), full_dR, out.data()});
+      };
       parallel_for(n, ViscousSystemPass<D, K, U>{P, G, params_, L, dt, diag, r.data()});  // r = b for now
+      if (full) {
+        parallel_for(n, FullStressSetupPass<D, K, U>{P, G, params_, L, carrier, fs[0].data()});
+        full_eval(nullptr, true);  // the boundary velocities' part goes to the right-hand side
+        parallel_for(n, [&](std::uint32_t i) {
+          if (in_system<D>(diag, i)) r[i] -= (dt / P.mass[i]) * full_dR[i];
+        });
+      }
       parallel_for(n, [&](std::uint32_t i) { x[i] = P.velocity[i]; });
-      parallel_for(n, ViscousApplyPass<D, K, U>{P, G, params_, L, dt, diag, x.data(), q.data()});
+      apply(x, q);
       const double b_norm = std::sqrt(dot(r, r));
       parallel_for(n, [&](std::uint32_t i) {
         if (in_system<D>(diag, i)) {
@@ -195,7 +225,7 @@ class CpuBackend final : public Backend {
       const double tol = double(params_.implicit_tolerance);
       int k = 0;
       while (res > tol && k < params_.implicit_max_iterations) {
-        parallel_for(n, ViscousApplyPass<D, K, U>{P, G, params_, L, dt, diag, p.data(), q.data()});
+        apply(p, q);
         const double pq = dot(p, q);
         if (!(pq > 0)) break;
         const Real alpha = Real(rz / pq);
@@ -217,9 +247,10 @@ class CpuBackend final : public Backend {
       out.iterations = k;
       out.residual = res;
       out.converged = res <= tol;
-      parallel_for(n, ViscousUpdatePass<D, K, U>{P, G, params_, L, dt, diag, x.data()});
+      if (full) full_eval(x.data(), true, P.viscous_load != nullptr);  // the update's and the reactions' evaluation
+      parallel_for(n, ViscousUpdatePass<D, K, U>{P, G, params_, L, dt, diag, x.data(), full_dR});
       if (P.viscous_load)
-        parallel_for(n, ViscousReactionPass<D, K, U>{P, G, params_, diag, x.data(), share, first_half});
+        parallel_for(n, ViscousReactionPass<D, K, U>{P, G, params_, diag, x.data(), share, first_half, full_dR});
     });
     return out;
   }
@@ -605,8 +636,17 @@ class CpuBackend final : public Backend {
   std::vector<Real> soa_;
   // Implicit viscosity: the conjugate-gradient vectors (x, r, z, p, A p) per dimension, the
   // diagonal, and the block sums of the fixed-order reductions.
-  std::vector<Vec<2>> cg2_[6];  // x, r, z, p, q and the diagonal of the implicit viscous CG
-  std::vector<Vec<3>> cg3_[6];
+  // x, r, z, p, q, the diagonal of the implicit viscous CG, the full-stress pair part and acceleration
+  std::vector<Vec<2>> cg2_[8];
+  std::vector<Vec<3>> cg3_[8];
+  std::vector<Real> carrier_mu_;  // full stress: the carriers' viscosity (0: not a carrier)
+  std::vector<Mat<2>> fs2_[3];    // full stress: renormalisation, gradient, Q
+  std::vector<Mat<3>> fs3_[3];
+  template <int D>
+  std::vector<Mat<D>>* full_stress_tensors() {
+    if constexpr (D == 2) return fs2_;
+    else return fs3_;
+  }
   std::vector<double> block_sums_;
   template <int D>
   std::vector<Vec<D>>* cg_vectors() {
