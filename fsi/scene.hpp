@@ -26,11 +26,10 @@ enum class ViscosityKind { artificial, laminar };
 // whose largest viscosity would put the explicit viscous limit below the acoustic one, explicitly
 // otherwise; explicit or implicit: every material that way (docs/choices.md).
 enum class ViscousIntegration { automatic, explicit_, implicit };
-// The laminar viscous stress (docs/choices.md): auto, the full deviatoric stress 2 mu D'
-// (sph/full_stress.hpp, integrated implicitly) for non-Newtonian materials integrated implicitly,
-// Morris' Laplacian form div(mu grad v) for the others; full: every material the full stress (and
-// so implicit); laplacian; or the central pair form (sph::pair::ViscousPair), whose limit is the
-// divergence of mu (grad v + grad v^T) + mu (div v) I.
+// The laminar viscous stress (docs/choices.md): auto (for now Morris' Laplacian form div(mu grad v)
+// for every material); full: the full deviatoric stress 2 mu D' (sph/full_stress.hpp, integrated
+// implicitly) for every material; laplacian; or the central pair form (sph::pair::ViscousPair),
+// whose limit is the divergence of mu (grad v + grad v^T) + mu (div v) I.
 enum class ViscousStress { automatic, laplacian, central, full };
 enum class BoundaryKind { dbc, mdbc };  // wall treatment; see docs/choices.md
 

@@ -132,7 +132,7 @@ time: {end: 0.008, cfl: 0.2}
 gravity: [0, -9.81]
 numerics:
   density_diffusion: {type: fourtakas, delta: 0.1}
-  viscosity: {type: laminar, integration: auto}
+  viscosity: {type: laminar, integration: auto, stress: full}
   boundary: {type: mdbc, velocity: no_slip}
 materials:
   debris: {model: bingham, density: 1800, viscosity: 0.5, yield_stress: 20, papanastasiou_exponent: 100,

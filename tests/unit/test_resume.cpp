@@ -255,7 +255,7 @@ TEST(CheckpointResume, ResumedRunThroughSplittingIsBitIdentical) {
 }
 
 // Implicit viscosity (issue #20): a Bingham column (no stated cap, so its viscosity at rest,
-// m tau_y + mu_p = 2000 Pa s, is integrated implicitly, in the full-stress form) collapsing in a
+// m tau_y + mu_p = 2000 Pa s, is integrated implicitly, with the full stress) collapsing in a
 // tank with no-slip mDBC walls, against a fixed structure. The next step's first viscous solve reads
 // the mirrored wall velocities and the effective viscosities of the last force pass, and the
 // structure's viscous load waits half a step in viscous_pending: the checkpoint must hold them all.
@@ -266,7 +266,7 @@ resolution: {particle_spacing: 0.01, smoothing_ratio: 1.3}
 time: {end: 0.06, cfl: 0.2}
 gravity: [0, -9.81]
 numerics:
-  viscosity: {type: laminar, integration: auto}
+  viscosity: {type: laminar, integration: auto, stress: full}
   boundary: {type: mdbc, velocity: no_slip}
 materials:
   debris: {model: bingham, density: 1800, viscosity: 0.5, yield_stress: 20, papanastasiou_exponent: 100,
