@@ -76,6 +76,19 @@ struct Mat {
   }
 };
 
+// a b (a as a plain array, as the passes accumulate it).
+template <int D>
+TURBID_HD inline Mat<D> product(const Real (&a)[D][D], const Mat<D>& b) {
+  Mat<D> out;
+  for (int r = 0; r < D; ++r)
+    for (int c = 0; c < D; ++c) {
+      Real s = 0;
+      for (int k = 0; k < D; ++k) s += a[r][k] * b.c[k][c];
+      out.c[r][c] = s;
+    }
+  return out;
+}
+
 // Whether fluid particle i has a full-stress implicit material.
 template <int D>
 TURBID_HD inline bool full_stress_particle(const ParticleView<D>& P, const PhysicsParams& prm, std::uint32_t i) {
@@ -224,14 +237,7 @@ struct FullStressGradientPass {
       for (int a = 0; a < D; ++a)
         for (int b = 0; b < D; ++b) g[a][b] += du[a] * VF * rij[b];
     });
-    Mat<D> out;
-    for (int a = 0; a < D; ++a)
-      for (int b = 0; b < D; ++b) {
-        Real s = 0;
-        for (int c = 0; c < D; ++c) s += g[a][c] * renorm[i].c[c][b];
-        out.c[a][b] = s;
-      }
-    grad[i] = out;
+    grad[i] = product<D>(g, renorm[i]);
   }
 };
 
@@ -279,14 +285,7 @@ struct FullStressStressPass {
       for (int a = 0; a < D; ++a)
         for (int b = 0; b < D; ++b) p[a][b] -= Real(0.5) * c * d[a] * rij[b];
     });
-    Mat<D> out;
-    for (int a = 0; a < D; ++a)
-      for (int b = 0; b < D; ++b) {
-        Real s = 0;
-        for (int c = 0; c < D; ++c) s += p[a][c] * renorm[i].c[c][b];
-        out.c[a][b] = s;
-      }
-    q[i] = out;
+    q[i] = product<D>(p, renorm[i]);
     direct[i] = dir;
   }
 };
