@@ -490,8 +490,7 @@ sph::PhysicsParams physics_params(const Scene& scene) {
     }
     // The viscous stress (docs/choices.md): the full deviatoric stress lives in the implicit update.
     // `auto` is the Laplacian form for now: beside DBC walls the full stress lets a yield-stress
-    // slide slip (the walls' zero velocities understate the wall shear), and beside mDBC walls the
-    // wet dam break lost two particles through a wall; both are open (issue #20).
+    // slide slip (the walls' zero velocities understate the wall shear); open (issue #20).
     const ViscousStress stress = scene.numerics.viscous_stress;
     const bool full = laminar && ms.viscosity + ms.consistency + ms.yield_stress > 0 && stress == ViscousStress::full;
     if (full && scene.numerics.viscous_integration == ViscousIntegration::explicit_)

@@ -136,13 +136,31 @@ struct ViscousApplyPass {
       out[i] = Vec<D>::zero();
       return;
     }
+    // (1 - dt sum_j diag(T_ij)) x_i + dt sum_fluid T_ij x_j, minus dt times the off-diagonal part of
+    // sum_j T_ij x_i (central pairs only); the same operations, in the same order, as before the
+    // pair operator could be a tensor, so a Laplacian-form run keeps its bits.
     const Vec<D> xi = x[i];
-    Vec<D> a = Vec<D>::zero();
+    Vec<D> dsum = Vec<D>::zero();
+    Vec<D> off = Vec<D>::zero();
+    Vec<D> cross = Vec<D>::zero();
+    bool central = false;
     for_each_implicit_pair<D, K, UniformH>(P, G, L, prm, i, [&](std::uint32_t j, const pair::ViscousPair<D>& T, bool boundary) {
-      a += T.apply(boundary ? xi : xi - x[j]);
+      const Vec<D> d = T.diagonal();
+      dsum += d;
+      if (!boundary) off += T.apply(x[j]);
+      if (T.central) {
+        central = true;
+        Vec<D> c = T.apply(xi);
+        for (int a = 0; a < D; ++a) c[a] -= d[a] * xi[a];
+        cross += c;
+      }
     });
-    if (full) a -= (Real(1) / P.mass[i]) * full[i];
-    out[i] = xi - dt * a;
+    Vec<D> o;
+    for (int a = 0; a < D; ++a) o[a] = (Real(1) - dt * dsum[a]) * xi[a];
+    o += dt * off;
+    if (central) o -= dt * cross;
+    if (full) o += (dt / P.mass[i]) * full[i];
+    out[i] = o;
   }
 };
 

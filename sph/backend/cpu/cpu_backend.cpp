@@ -177,7 +177,7 @@ class CpuBackend final : public Backend {
     Real* carrier = carrier_mu_.data();
     // z = r / diag, component by component (the Jacobi preconditioner)
     const auto precondition = [&](std::uint32_t i) {
-      for (int c = 0; c < D; ++c) z[i][c] = r[i][c] / diag[i][c];
+      for (int c = 0; c < D; ++c) z[i][c] = (Real(1) / diag[i][c]) * r[i][c];
     };
     const NeighbourList L = list(false);
     const auto dot = [&](const std::vector<Vec<D>>& a, const std::vector<Vec<D>>& b) {
