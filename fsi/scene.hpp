@@ -278,7 +278,9 @@ struct NumericsSpec {
   double min_time_step = 1.0e-9;           // a smaller dt stops the run as collapsed [s]
   double density_ratio_limit = 0.5;        // |rho/rho0 - 1| above this stops the run [-]
   BoundaryKind boundary = BoundaryKind::dbc;  // wall treatment for walls and structures
-  bool no_slip = false;                    // mDBC: boundary velocity mirrors the fluid's (no-slip walls)
+  // Walls and structures show the viscous terms the fluid's velocity mirrored at their ghost nodes
+  // (no-slip at the wall surface); unset: yes where a material has the full viscous stress.
+  std::optional<bool> no_slip;
   bool interface_correction = true;        // ghost-density correction across material interfaces (paper eq. 3)
   int split_relaxation = 10;               // relaxation steps after each split (sph/splitting.hpp); 0 = off
   double shifting_coefficient = 0;         // particle shifting A [-]; 0 = off

@@ -488,11 +488,15 @@ sph::PhysicsParams physics_params(const Scene& scene) {
       p.materials[m].non_newtonian = true;
       p.rheology = true;
     }
-    // The viscous stress (docs/choices.md): the full deviatoric stress lives in the implicit update.
-    // `auto` is the Laplacian form for now: beside DBC walls the full stress lets a yield-stress
-    // slide slip (the walls' zero velocities understate the wall shear); open (issue #20).
+    // The viscous stress (docs/choices.md): the full deviatoric stress lives in the implicit update;
+    // `auto` gives it to the non-Newtonian materials (where mu varies by orders of magnitude across
+    // a yield surface, div(mu grad v^T) is not small), unless the scene asks for explicit integration.
     const ViscousStress stress = scene.numerics.viscous_stress;
-    const bool full = laminar && ms.viscosity + ms.consistency + ms.yield_stress > 0 && stress == ViscousStress::full;
+    const bool non_newtonian = ms.model != "newtonian";
+    const bool explicit_asked = scene.numerics.viscous_integration == ViscousIntegration::explicit_;
+    const bool full = laminar && ms.viscosity + ms.consistency + ms.yield_stress > 0 &&
+                      (stress == ViscousStress::full ||
+                       (stress == ViscousStress::automatic && non_newtonian && !explicit_asked));
     if (full && scene.numerics.viscous_integration == ViscousIntegration::explicit_)
       throw std::invalid_argument(material_error(ms) +
                                   "the full viscous stress ('stress: full') is integrated implicitly; use "
@@ -528,7 +532,10 @@ sph::PhysicsParams physics_params(const Scene& scene) {
   }
   for (int k = 0; k < 3; ++k) p.hydrostatic_gravity[k] = p.period[k] > 0 ? sph::Real(0) : p.gravity[k];
   p.boundary = scene.numerics.boundary == BoundaryKind::mdbc ? sph::Boundary::mdbc : sph::Boundary::dbc;
-  p.mdbc_no_slip = scene.numerics.no_slip;
+  // The full stress is built from renormalised gradients over 2h: walls at their own velocity put a
+  // kink into the profile at the wall, the gradients average it away and the wall shear comes out
+  // at about half (a yield-stress layer slid on DBC walls); by default its walls mirror the fluid.
+  p.wall_no_slip = scene.numerics.no_slip.value_or(p.full_stress);
   for (const auto& w : scene.walls) p.free_slip_walls = p.free_slip_walls || w.free_slip;
   p.body_count = int(scene.structures.size());
   p.zone_count = int(scene.open_boundaries.size());

@@ -192,13 +192,16 @@ TURBID_HD inline Real ghost_interpolation(const ParticleView<D>& P, const GridVi
 // 2 v_wall - v~_g, v~_g the fluid velocity at the ghost node, so that it goes through v_wall at the
 // wall surface (English et al. 2022; Adami et al. 2012, C6); continuity keeps the wall's own
 // velocity (mirroring the normal component there doubled the compression in front of a cylinder
-// and let fluid through). Fixed walls: v_wall = 0; moving structures carry their rigid velocity.
+// and let fluid through). Fixed walls: v_wall = 0; moving structures carry their rigid velocity;
+// free-slip walls, which no viscous term reads, their own. With DBC walls (density = false) the
+// pass sets only the no-slip velocity (the full viscous stress asks for it, PhysicsParams::wall_no_slip).
 template <int D, class K, bool UniformH>
 struct MdbcPass {
   ParticleView<D> P;
   GridView<D> G;
   PhysicsParams prm;
   bool no_slip = true;
+  bool density = true;  // false: DBC walls, whose density continuity keeps
 
   TURBID_HD void operator()(std::uint32_t b) const {
     const std::uint8_t kind = P.kind[b];
@@ -215,9 +218,10 @@ struct MdbcPass {
       if (fluid < prm.mdbc_wet_share * (Real(1) - walls)) rho = rho0;
     }
     const Real rho_min = prm.materials[prm.wall_material].eos.no_tension_density();
-    P.density[b] = rho > rho_min ? rho : rho_min;
+    if (density) P.density[b] = rho > rho_min ? rho : rho_min;
     // 2 v_wall - v~_g; a fixed wall has v_wall = 0, a moving structure its rigid velocity.
-    if (no_slip) P.viscous_velocity[b] = Real(2) * P.velocity[b] - v_ghost;
+    const bool free_slip = P.free_slip && P.free_slip[b];
+    if (no_slip) P.viscous_velocity[b] = free_slip ? P.velocity[b] : Real(2) * P.velocity[b] - v_ghost;
   }
 };
 

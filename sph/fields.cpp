@@ -26,12 +26,13 @@ FieldIds register_fields(ParticleStore& s, const PhysicsParams& p, bool structur
     f.density_gradient = s.add_field({"density_gradient", "kg/m^4", ScalarType::f32, d, false, false, false, Carry::recompute});
   // Ghost node offset x_g - x_b: twice the particle's depth below the wall surface, along the
   // outward normal (zero for fluid).
-  if (p.boundary == Boundary::mdbc)
+  // Also with the full viscous stress, whose walls take the no-slip velocity from their ghost nodes.
+  if (p.boundary == Boundary::mdbc || p.wall_no_slip)
     f.boundary_normal = s.add_field({"boundary_normal", "m", ScalarType::f32, d, true, true, true, Carry::copy});
   // Recomputed by the mDBC pass after every sort, before the momentum pass reads it; the implicit
   // viscous update at the start of the next step reads it too, so with implicit viscosity it is
   // checkpointed (bit-identical resume), like the acceleration.
-  if (p.boundary == Boundary::mdbc && p.mdbc_no_slip)
+  if (p.wall_no_slip)
     f.viscous_velocity = s.add_field(
         {"viscous_velocity", "m/s", ScalarType::f32, d, false, p.implicit_viscosity, false, Carry::recompute});
   if (structures) {
@@ -43,7 +44,7 @@ FieldIds register_fields(ParticleStore& s, const PhysicsParams& p, bool structur
   // checkpointed (they cannot be recomputed from rounded positions bit for bit).
   if (structures && moving_bodies) {
     f.body_offset = s.add_field({"body_offset", "m", ScalarType::f32, d, false, true, true, Carry::copy});
-    if (p.boundary == Boundary::mdbc)
+    if (p.boundary == Boundary::mdbc || p.wall_no_slip)
       f.body_normal = s.add_field({"body_normal", "m", ScalarType::f32, d, false, true, true, Carry::copy});
   }
   // Computed by the momentum pass after each sort and used by the next drift, like the

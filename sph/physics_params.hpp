@@ -73,7 +73,7 @@ struct PhysicsParams {
   Diffusion diffusion = Diffusion::fourtakas;
   Viscosity viscosity = Viscosity::artificial;
   Boundary boundary = Boundary::dbc;
-  bool mdbc_no_slip = false;   // mDBC: boundary velocity mirrors the fluid's (no-slip), else stays the wall's
+  bool wall_no_slip = false;   // boundary velocity in viscous terms mirrors the fluid's (no-slip), else stays the wall's
   Real mdbc_wet_share = Real(0.5);  // mDBC: a ghost node with less fluid than this share of its support is dry
   // Some walls are free-slip: their particles carry the `free_slip` field, and the viscous terms
   // (laminar viscosity, velocity gradient) leave them out.

@@ -306,11 +306,8 @@ std::string describe_scene(const fsi::Scene& scene) {
   if (s.structure_particles > 0) os << ", structure " << s.structure_particles;
   if (s.buffer_particles > 0) os << ", open-boundary buffer " << s.buffer_particles;
   os << ")\n";
-  os << "wall treatment   "
-     << (scene.numerics.boundary == fsi::BoundaryKind::mdbc
-             ? (scene.numerics.no_slip ? "mDBC (no-slip)" : "mDBC (wall velocity)")
-             : "DBC")
-     << "\n";
+  os << "wall treatment   " << (scene.numerics.boundary == fsi::BoundaryKind::mdbc ? "mDBC" : "DBC")
+     << (sim.params().wall_no_slip ? " (no-slip: mirrored velocity)" : " (wall velocity)") << "\n";
   const bool two_d = scene.dimensions == 2;
   for (const auto& st : s.structures)
     os << "  structure " << st.name << ": " << st.particles << " particles, surface "

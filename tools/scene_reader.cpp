@@ -564,11 +564,7 @@ void Reader::read_numerics(const Value& v, fsi::NumericsSpec& n) const {
   if (auto bv = m.get("boundary")) {
     MapView b(*this, *bv, {"type", "velocity"});
     n.boundary = choice(b.need("type"), {"dbc", "mdbc"}) == 0 ? fsi::BoundaryKind::dbc : fsi::BoundaryKind::mdbc;
-    if (auto vel = b.get("velocity")) {
-      if (n.boundary != fsi::BoundaryKind::mdbc)
-        fail(b.key_mark("velocity"), "'velocity' applies only to the 'mdbc' boundary (DBC walls keep their own velocity)");
-      n.no_slip = choice(*vel, {"no_slip", "wall"}) == 0;
-    }
+    if (auto vel = b.get("velocity")) n.no_slip = choice(*vel, {"no_slip", "wall"}) == 0;
   }
   if (auto k = m.get("kernel"))
     n.kernel = choice(*k, {"wendland_c2", "cubic_spline"}) == 0 ? sph::KernelKind::wendland_c2
@@ -790,7 +786,7 @@ void Reader::read_walls(const Value& v, fsi::Scene& scene, std::vector<YAML::Mar
       wall.free_slip = choice(*sl, {"no_slip", "free"}) == 1;
       if (wall.free_slip && scene.numerics.viscosity != fsi::ViscosityKind::laminar)
         fail(sl->mark, "'slip: free' acts on the laminar viscosity term; this scene uses artificial viscosity");
-      if (wall.free_slip && scene.numerics.boundary == fsi::BoundaryKind::mdbc && scene.numerics.no_slip)
+      if (wall.free_slip && scene.numerics.boundary == fsi::BoundaryKind::mdbc && scene.numerics.no_slip.value_or(false))
         fail(sl->mark, "'slip: free' is for DBC walls or mDBC without 'velocity: no_slip'");
     }
     scene.walls.push_back(wall);

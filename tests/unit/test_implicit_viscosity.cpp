@@ -208,13 +208,16 @@ namespace {
 
 // Which integrator and stress form each material gets (fsi::physics_params; docs/choices.md): the
 // scene's keys against the defaults, and the located error for a combination that cannot run.
-sph::PhysicsParams params_of(const std::string& numerics, const std::string& debris_extra = "") {
+sph::PhysicsParams params_of(const std::string& numerics, const std::string& debris_extra = "",
+                             const std::string& wall_velocity = "") {
+  const std::string boundary =
+      wall_velocity.empty() ? std::string() : "\n  boundary: {type: dbc, velocity: " + wall_velocity + "}";
   return fsi::physics_params(test::scene_of(R"(name: choices
 dimensions: 2
 resolution: {particle_spacing: 0.01, smoothing_ratio: 2.0}
 time: {end: 0.1}
 numerics:
-  viscosity: {type: laminar)" + numerics + R"(}
+  viscosity: {type: laminar)" + numerics + "}" + boundary + R"(
 materials:
   water: {model: newtonian, density: 1000, viscosity: 1.0e-3, sound_speed: 20}
   debris: {model: bingham, density: 1800, viscosity: 0.5, yield_stress: 20, papanastasiou_exponent: 100,
@@ -226,16 +229,25 @@ fluids:
 }
 
 TEST(ViscousChoices, IntegratorAndStressFormPerMaterial) {
-  // Default: the uncapped yield-stress debris implicit, the water explicit, both in the Laplacian
-  // form (auto: the full stress is opt-in until its wall treatment is settled, docs/choices.md).
+  // Default (auto): the non-Newtonian debris gets the full stress, and so the implicit update; the
+  // Newtonian water stays explicit in the Laplacian form; walls mirror the fluid's velocity (the
+  // full stress's gradients need the no-slip profile through the wall, docs/choices.md).
   const sph::PhysicsParams d = params_of("");
   EXPECT_TRUE(d.materials[1].implicit_viscosity);
-  EXPECT_FALSE(d.materials[1].full_stress);
+  EXPECT_TRUE(d.materials[1].full_stress);
   EXPECT_FALSE(d.materials[0].implicit_viscosity || d.materials[0].full_stress);
-  EXPECT_FALSE(d.full_stress);
-  // A stated cap low enough for explicit integration keeps the debris explicit.
-  const sph::PhysicsParams capped = params_of("", ", max_viscosity: 1");
+  EXPECT_TRUE(d.full_stress);
+  EXPECT_TRUE(d.wall_no_slip);
+  // ... unless the walls' velocity is stated.
+  EXPECT_FALSE(params_of(", stress: full", "", "wall").wall_no_slip);
+  // A stated cap with `integration: explicit` keeps the debris explicit, in the Laplacian form.
+  const sph::PhysicsParams capped = params_of(", integration: explicit", ", max_viscosity: 1");
   EXPECT_FALSE(capped.materials[1].implicit_viscosity || capped.materials[1].full_stress);
+  EXPECT_FALSE(capped.wall_no_slip);
+  // stress: laplacian keeps the Laplacian form, implicit where the material needs it.
+  const sph::PhysicsParams lap = params_of(", stress: laplacian");
+  EXPECT_TRUE(lap.materials[1].implicit_viscosity);
+  EXPECT_FALSE(lap.materials[1].full_stress || lap.full_stress || lap.wall_no_slip);
   // integration: implicit covers the Newtonian water too (Laplacian form unless stress: full).
   const sph::PhysicsParams all = params_of(", integration: implicit");
   EXPECT_TRUE(all.materials[0].implicit_viscosity);

@@ -301,7 +301,7 @@ void check_momentum_mixed_h(sph::Viscosity viscosity, sph::Boundary boundary) {
   p.viscosity = viscosity;
   p.artificial_viscosity = Real(0.05);
   p.boundary = boundary;
-  p.mdbc_no_slip = boundary == Boundary::mdbc;
+  p.wall_no_slip = boundary == Boundary::mdbc;
   p.rheology = viscosity == Viscosity::laminar;
   p.body_count = 1;
   p.material_count = 2;

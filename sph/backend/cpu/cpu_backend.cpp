@@ -523,8 +523,8 @@ class CpuBackend final : public Backend {
     dispatch_kernel<D>(params_, [&](auto kernel_tag, auto uniform_tag) {
       using K = typename decltype(kernel_tag)::type;
       constexpr bool U = decltype(uniform_tag)::value;
-      if (params_.boundary == Boundary::mdbc)
-        parallel_for(P.count, MdbcPass<D, K, U>{P, G, params_, params_.mdbc_no_slip});
+      if (params_.boundary == Boundary::mdbc || params_.wall_no_slip)
+        parallel_for(P.count, MdbcPass<D, K, U>{P, G, params_, params_.wall_no_slip, params_.boundary == Boundary::mdbc});
       if (params_.zone_count > 0) parallel_for(P.count, BufferPass<D, K, U>{P, G, params_});
       if (params_.rheology) parallel_for(P.count, RheologyPass<D, K, U>{P, G, params_});
       parallel_for(P.count, PressurePass<D>{P, params_});

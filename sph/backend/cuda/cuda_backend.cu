@@ -504,8 +504,8 @@ class CudaBackend final : public Backend {
     dispatch_kernel<D>(params_, [&](auto kernel_tag, auto uniform_tag) {
       using K = typename decltype(kernel_tag)::type;
       constexpr bool U = decltype(uniform_tag)::value;
-      if (params_.boundary == Boundary::mdbc)
-        launch("MdbcPass", P.count, MdbcPass<D, K, U>{P, G, params_, params_.mdbc_no_slip});
+      if (params_.boundary == Boundary::mdbc || params_.wall_no_slip)
+        launch("MdbcPass", P.count, MdbcPass<D, K, U>{P, G, params_, params_.wall_no_slip, params_.boundary == Boundary::mdbc});
       if (params_.zone_count > 0) launch("BufferPass", P.count, BufferPass<D, K, U>{P, G, params_});
       if (params_.rheology) launch("RheologyPass", P.count, RheologyPass<D, K, U>{P, G, params_});
       launch("PressurePass", P.count, PressurePass<D>{P, params_});
