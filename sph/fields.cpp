@@ -26,7 +26,7 @@ FieldIds register_fields(ParticleStore& s, const PhysicsParams& p, bool structur
     f.density_gradient = s.add_field({"density_gradient", "kg/m^4", ScalarType::f32, d, false, false, false, Carry::recompute});
   // Ghost node offset x_g - x_b: twice the particle's depth below the wall surface, along the
   // outward normal (zero for fluid).
-  // Also with the full viscous stress, whose walls take the no-slip velocity from their ghost nodes.
+  // Also for no-slip DBC walls (wall_no_slip), whose mirrored velocity comes from their ghost nodes.
   if (p.boundary == Boundary::mdbc || p.wall_no_slip)
     f.boundary_normal = s.add_field({"boundary_normal", "m", ScalarType::f32, d, true, true, true, Carry::copy});
   // Recomputed by the mDBC pass after every sort, before the momentum pass reads it; the implicit
