@@ -111,7 +111,9 @@ inline constexpr Real kMdbcMinGradientGain = Real(0.1);
 // nothing set then); `boundary_share` gets the same sum over the other particles (walls, structures,
 // buffers) with their rest volumes: their densities are what the calling pass writes, so reading
 // them would race with it (and depend on the thread schedule).
-template <int D, class K, bool UniformH>
+// WithDensity = false (DBC walls that only want the no-slip velocity): only the Shepard sums are
+// built; no moment matrix, no solve, `density` untouched.
+template <int D, class K, bool UniformH, bool WithDensity = true>
 TURBID_HD inline Real ghost_interpolation(const ParticleView<D>& P, const GridView<D>& G, const PhysicsParams& prm,
                                           const Vec<D>& xg, const Vec<D>& offset, Real h_b, int ref, Real& density,
                                           Vec<D>& velocity, Real& boundary_share) {
@@ -141,11 +143,13 @@ TURBID_HD inline Real ghost_interpolation(const ParticleView<D>& P, const GridVi
         boundary_share += W * P.mass[j] / prm.materials[mb].eos.rest_density;
         continue;
       }
-      const Real F = K::f_inv(rr, Real(1) / h);  // grad_g W_gj = F r
       const Real V = P.mass[j] / P.density[j];
+      vsum += (W * V) * P.velocity[j];
+      A[0][0] += W * V;
+      if constexpr (!WithDensity) continue;
+      const Real F = K::f_inv(rr, Real(1) / h);  // grad_g W_gj = F r
       const int mat = P.material[j];
       const Real m = mat == ref ? P.mass[j] : V * eos.density_at(prm.materials[mat].eos.pressure(P.density[j]));
-      A[0][0] += W * V;
       rhs[0] += m * W;
       for (int a = 0; a < D; ++a) {
         A[0][1 + a] -= r[a] * W * V;
@@ -153,11 +157,12 @@ TURBID_HD inline Real ghost_interpolation(const ParticleView<D>& P, const GridVi
         rhs[1 + a] += m * F * r[a];
         for (int k = 0; k < D; ++k) A[1 + a][1 + k] -= F * r[a] * r[k] * V;
       }
-      vsum += (W * V) * P.velocity[j];
     }
   });
   const Real shepard = A[0][0];
   if (!(shepard > Real(0))) return Real(0);
+  velocity = (Real(1) / shepard) * vsum;
+  if constexpr (!WithDensity) return shepard;
   const Real shepard_density = rhs[0] / shepard;
   // The gradient block once rho_g is eliminated: the Schur complement S = A_gg - A_g0 A_0g / A_00
   // (dimensionless; about the identity in a full support). Its smallest singular value is the gain
@@ -174,7 +179,6 @@ TURBID_HD inline Real ghost_interpolation(const ParticleView<D>& P, const GridVi
   } else {
     density = shepard_density;
   }
-  velocity = (Real(1) / shepard) * vsum;
   return shepard;
 }
 
@@ -213,9 +217,14 @@ struct MdbcPass {
     Vec<D> v_ghost = Vec<D>::zero();
     if (norm2(n) > Real(0)) {
       Real walls = 0;
-      const Real fluid = ghost_interpolation<D, K, UniformH>(P, G, prm, P.position[b] + n, n, h_b, prm.wall_material,
-                                                             rho, v_ghost, walls);
-      if (fluid < prm.mdbc_wet_share * (Real(1) - walls)) rho = rho0;
+      const Vec<D> xg = P.position[b] + n;
+      if (density) {
+        const Real fluid = ghost_interpolation<D, K, UniformH>(P, G, prm, xg, n, h_b, prm.wall_material, rho, v_ghost,
+                                                               walls);
+        if (fluid < prm.mdbc_wet_share * (Real(1) - walls)) rho = rho0;
+      } else {
+        ghost_interpolation<D, K, UniformH, false>(P, G, prm, xg, n, h_b, prm.wall_material, rho, v_ghost, walls);
+      }
     }
     const Real rho_min = prm.materials[prm.wall_material].eos.no_tension_density();
     if (density) P.density[b] = rho > rho_min ? rho : rho_min;

@@ -517,6 +517,9 @@ nlohmann::json run_scene(const RunRequest& request) {
     report["structures"] = list;
   }
   report["backend"] = sim.backend_name();
+  // The velocity the viscous terms see at walls: the fluid's mirrored at ghost nodes or the wall's own.
+  report["wall_treatment"] = {{"type", scene.numerics.boundary == fsi::BoundaryKind::mdbc ? "mdbc" : "dbc"},
+                              {"velocity", sim.params().wall_no_slip ? "no_slip" : "wall"}};
   report["threads"] = sim.threads();
   report["git_revision"] = TURBID_GIT_REVISION;
   report["version"] = TURBID_VERSION;

@@ -786,8 +786,6 @@ void Reader::read_walls(const Value& v, fsi::Scene& scene, std::vector<YAML::Mar
       wall.free_slip = choice(*sl, {"no_slip", "free"}) == 1;
       if (wall.free_slip && scene.numerics.viscosity != fsi::ViscosityKind::laminar)
         fail(sl->mark, "'slip: free' acts on the laminar viscosity term; this scene uses artificial viscosity");
-      if (wall.free_slip && scene.numerics.boundary == fsi::BoundaryKind::mdbc && scene.numerics.no_slip.value_or(false))
-        fail(sl->mark, "'slip: free' is for DBC walls or mDBC without 'velocity: no_slip'");
     }
     scene.walls.push_back(wall);
     wall_marks.push_back(item.mark);

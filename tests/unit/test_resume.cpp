@@ -259,8 +259,7 @@ TEST(CheckpointResume, ResumedRunThroughSplittingIsBitIdentical) {
 // tank with no-slip mDBC walls, against a fixed structure. The next step's first viscous solve reads
 // the mirrored wall velocities and the effective viscosities of the last force pass, and the
 // structure's viscous load waits half a step in viscous_pending: the checkpoint must hold them all.
-TEST(CheckpointResume, ResumedRunWithImplicitViscosityAndMdbcIsBitIdentical) {
-  const auto r = check_resume(R"(name: resume_implicit_viscosity
+constexpr const char* kImplicitScene = R"(name: resume_implicit_viscosity
 dimensions: 2
 resolution: {particle_spacing: 0.01, smoothing_ratio: 1.3}
 time: {end: 0.06, cfl: 0.2}
@@ -280,7 +279,25 @@ fluids:
 probes:
   - {name: front, type: front_position, material: debris, axis: x}
 output: {every: 0.01, vtk: true}
-)");
+)";
+
+TEST(CheckpointResume, ResumedRunWithImplicitViscosityAndMdbcIsBitIdentical) {
+  const auto r = check_resume(kImplicitScene);
   EXPECT_EQ(r.full.at("status"), "completed");
+  EXPECT_GT(r.full.at("viscous_solves").get<long>(), 0) << "the implicit solve must run";
+}
+
+// The same on DBC walls, whose no-slip velocity (the default with the full stress) is mirrored at
+// their ghost nodes while their density comes from continuity.
+TEST(CheckpointResume, ResumedRunWithImplicitViscosityAndNoSlipDbcIsBitIdentical) {
+  std::string scene = kImplicitScene;
+  const std::string mdbc = "  boundary: {type: mdbc, velocity: no_slip}\n";
+  const auto at = scene.find(mdbc);
+  ASSERT_NE(at, std::string::npos);
+  scene.replace(at, mdbc.size(), "  boundary: {type: dbc}\n");
+  const auto r = check_resume(scene);
+  EXPECT_EQ(r.full.at("status"), "completed");
+  EXPECT_EQ(r.full.at("wall_treatment").at("type"), "dbc");
+  EXPECT_EQ(r.full.at("wall_treatment").at("velocity"), "no_slip") << "the full stress's default";
   EXPECT_GT(r.full.at("viscous_solves").get<long>(), 0) << "the implicit solve must run";
 }

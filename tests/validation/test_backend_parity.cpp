@@ -1,6 +1,7 @@
 // CPU/GPU parity over many steps (issue #3): scenes/dam_break_2d.yaml and
 // scenes/hydrostatic_tank_2d.yaml, 2000 steps on the CPU and on the CUDA backend, compared particle
-// by particle (by id) in position, velocity and density. Skipped without a GPU.
+// by particle (by id) in position, velocity and density; the dam break also with the laminar
+// viscosity and no-slip DBC or mDBC walls (the ghost-node passes). Skipped without a GPU.
 //
 // The bound, and why. Both backends compute in float32 with the same formulas; they differ in the
 // association of sums and in fused multiply-adds, i.e. by rounding, about one float ulp per
@@ -100,13 +101,15 @@ std::string compared_backend() {
   return b ? b : "cuda";
 }
 
-void expect_parity(const std::string& scene_name) {
+// `variant` changes the scene after reading (its label is printed with the scene's name).
+void expect_parity(const std::string& scene_name, void (*variant)(fsi::Scene&) = nullptr, const char* label = "") {
   const std::string other = compared_backend();
   std::string reason;
   if (other == "cuda" && sph::cuda_device_count(&reason) == 0) GTEST_SKIP() << reason;
   const std::string path = std::string(TURBID_SOURCE_DIR) + "/scenes/" + scene_name + ".yaml";
   fsi::Scene scene = tools::read_scene_file(path);
   scene.output.vtk = false;
+  if (variant) variant(scene);
   const double dx = scene.particle_spacing, rho0 = scene.materials.at(0).density;
   const double speed = std::sqrt(9.81 * 0.6);  // sqrt(g H) of both scenes' water depth scale [m/s]
 
@@ -123,8 +126,8 @@ void expect_parity(const std::string& scene_name) {
   cpu.start();
   ulp.start();
   gpu.start();
-  std::printf("[ measured ] %s, CPU vs CUDA (D) and CPU vs CPU moved by one ulp (E), max over particles:\n",
-              scene_name.c_str());
+  std::printf("[ measured ] %s%s, CPU vs %s (D) and CPU vs CPU moved by one ulp (E), max over particles:\n",
+              scene_name.c_str(), label, other.c_str());
   std::printf("  %6s %12s %12s %12s %12s %12s %12s %12s\n", "step", "D x/dx", "E x/dx", "D v/sqrt(gH)",
               "E v/sqrt(gH)", "D rho/rho0", "E rho/rho0", "t_gpu-t_cpu");
   int next = 0;
@@ -148,5 +151,29 @@ void expect_parity(const std::string& scene_name) {
 
 TEST(BackendParity, DamBreak2DOver2000Steps) { expect_parity("dam_break_2d"); }
 TEST(BackendParity, HydrostaticTank2DOver2000Steps) { expect_parity("hydrostatic_tank_2d"); }
+
+// The wall passes that the viscous terms read (issue #20): the dam break with the laminar viscosity
+// and no-slip walls that mirror the fluid's velocity at their ghost nodes (MdbcPass), on DBC walls
+// (velocity only) and on mDBC walls (density and velocity).
+TEST(BackendParity, DamBreak2DNoSlipDbcWallsOver2000Steps) {
+  expect_parity(
+      "dam_break_2d",
+      [](fsi::Scene& s) {
+        s.numerics.viscosity = fsi::ViscosityKind::laminar;
+        s.numerics.boundary = fsi::BoundaryKind::dbc;
+        s.numerics.no_slip = true;
+      },
+      " (laminar, DBC walls, velocity: no_slip)");
+}
+TEST(BackendParity, DamBreak2DNoSlipMdbcWallsOver2000Steps) {
+  expect_parity(
+      "dam_break_2d",
+      [](fsi::Scene& s) {
+        s.numerics.viscosity = fsi::ViscosityKind::laminar;
+        s.numerics.boundary = fsi::BoundaryKind::mdbc;
+        s.numerics.no_slip = true;
+      },
+      " (laminar, mDBC walls, velocity: no_slip)");
+}
 
 }  // namespace
