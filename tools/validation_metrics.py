@@ -21,10 +21,11 @@ step when a definition changes.
   poiseuille_*_2d      L2 error of the steady velocity profile (last VTK frame, bins of one
                        spacing) against physics.md D6; also the plug half-width's relative error.
   lock_exchange_*_2d   front speed U / sqrt(g' H) between x = 0.5 and 1.1 m.
-  submarine_landslide* suspended height of the soil (seed paper Table 1): at the last frame, the
-                       largest height above the bed, y - max(1.5 - x, 0) (the 45-degree slope, then
-                       the flat bottom), of the centre of any particle of a soil material (every
-                       fluid material but `water`: slide, turbidity); `suspended-height RUN...`.
+  submarine_landslide* suspended height of the soil (seed paper Table 1): at the last frame (or the
+                       one nearest `--time T`), the largest height above the bed, y - max(1.5 - x, 0)
+                       (the 45-degree slope, then the flat bottom), of the centre of any particle of
+                       a soil material (every fluid material but `water`: slide, turbidity);
+                       `suspended-height [--time T] RUN...`.
 
 Run as a script, it plots the dam-break front of one or more runs against the experiment:
 
@@ -486,14 +487,17 @@ def plot_lock_exchange(runs, png, labels=None, depth=0.2):
 LANDSLIDE_SLOPE_TOE = 1.5  # x [m] where the 45-degree slope of the landslide scenes meets the bottom
 
 
-def suspended_height(run_dir, frame=-1):
-    """Highest soil particle above the bed at one frame (the last by default): (height [m], material,
-    x [m], y [m] of that particle, soil particles counted); soil = every fluid material but water."""
+def suspended_height(run_dir, time=None):
+    """Highest soil particle above the bed at one frame (the last, or the one nearest `time` [s]):
+    (height [m], material, x [m], y [m] of that particle, soil particles counted, the frame's time
+    [s]); soil = every fluid material but water."""
     from turbid_vtp import frames, read_vtp
 
     report, _ = read_run(run_dir)
     names = [m["name"] for m in report["materials"]]
-    a = read_vtp(frames(run_dir)[frame][1])
+    all_frames = frames(run_dir)
+    t, path = all_frames[-1] if time is None else min(all_frames, key=lambda f: abs(f[0] - time))
+    a = read_vtp(path)
     best = (float("-inf"), None, None, None)
     count = 0
     dims = report["dimensions"]
@@ -505,7 +509,7 @@ def suspended_height(run_dir, frame=-1):
         height = y - max(LANDSLIDE_SLOPE_TOE - x, 0.0)
         if height > best[0]:
             best = (height, names[a["material"][k]], x, y)
-    return best + (count,)
+    return best + (count, t)
 
 
 def main(argv):
@@ -521,6 +525,7 @@ def main(argv):
     lx.add_argument("--labels", help="comma-separated legend labels, one per run")
     sh = sub.add_parser("suspended-height", help="the soil's highest point above the bed (landslide runs)")
     sh.add_argument("runs", nargs="+", help="run directories of a submarine_landslide scene")
+    sh.add_argument("--time", type=float, help="the frame nearest this time [s] (default: the last frame)")
     e = sub.add_parser("error", help="print the metric of a run directory")
     e.add_argument("scene", choices=sorted(METRICS))
     e.add_argument("run")
@@ -541,8 +546,8 @@ def main(argv):
         print(f"wrote {args.png}")
     elif args.command == "suspended-height":
         for run_dir in args.runs:
-            h, material, x, y, n = suspended_height(run_dir)
-            print(f"{run_dir}: suspended height {h:.4f} m ({material} particle at x = {x:.3f} m, "
+            h, material, x, y, n, t = suspended_height(run_dir, args.time)
+            print(f"{run_dir}: suspended height {h:.4f} m at t = {t:.3f} s ({material} particle at x = {x:.3f} m, "
                   f"y = {y:.3f} m; {n} soil particles)")
     elif args.command == "error":
         m = METRICS[args.scene]
