@@ -155,25 +155,17 @@ TEST(BackendParity, HydrostaticTank2DOver2000Steps) { expect_parity("hydrostatic
 // The wall passes that the viscous terms read (issue #20): the dam break with the laminar viscosity
 // and no-slip walls that mirror the fluid's velocity at their ghost nodes (MdbcPass), on DBC walls
 // (velocity only) and on mDBC walls (density and velocity).
+template <fsi::BoundaryKind Walls>
+void laminar_no_slip(fsi::Scene& s) {
+  s.numerics.viscosity = fsi::ViscosityKind::laminar;
+  s.numerics.boundary = Walls;
+  s.numerics.no_slip = true;
+}
 TEST(BackendParity, DamBreak2DNoSlipDbcWallsOver2000Steps) {
-  expect_parity(
-      "dam_break_2d",
-      [](fsi::Scene& s) {
-        s.numerics.viscosity = fsi::ViscosityKind::laminar;
-        s.numerics.boundary = fsi::BoundaryKind::dbc;
-        s.numerics.no_slip = true;
-      },
-      " (laminar, DBC walls, velocity: no_slip)");
+  expect_parity("dam_break_2d", laminar_no_slip<fsi::BoundaryKind::dbc>, " (laminar, DBC walls, velocity: no_slip)");
 }
 TEST(BackendParity, DamBreak2DNoSlipMdbcWallsOver2000Steps) {
-  expect_parity(
-      "dam_break_2d",
-      [](fsi::Scene& s) {
-        s.numerics.viscosity = fsi::ViscosityKind::laminar;
-        s.numerics.boundary = fsi::BoundaryKind::mdbc;
-        s.numerics.no_slip = true;
-      },
-      " (laminar, mDBC walls, velocity: no_slip)");
+  expect_parity("dam_break_2d", laminar_no_slip<fsi::BoundaryKind::mdbc>, " (laminar, mDBC walls, velocity: no_slip)");
 }
 
 }  // namespace
