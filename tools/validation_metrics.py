@@ -491,12 +491,11 @@ def suspended_height(run_dir, time=None):
     """Highest soil particle above the bed at one frame (the last, or the one nearest `time` [s]):
     (height [m], material, x [m], y [m] of that particle, soil particles counted, the frame's time
     [s]); soil = every fluid material but water."""
-    from turbid_vtp import frames, read_vtp
+    from turbid_vtp import frame_at, frames, read_vtp
 
     report, _ = read_run(run_dir)
     names = [m["name"] for m in report["materials"]]
-    all_frames = frames(run_dir)
-    t, path = all_frames[-1] if time is None else min(all_frames, key=lambda f: abs(f[0] - time))
+    t, path = frames(run_dir)[-1] if time is None else frame_at(run_dir, time)
     a = read_vtp(path)
     best = (float("-inf"), None, None, None)
     count = 0
