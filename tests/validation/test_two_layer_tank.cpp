@@ -51,7 +51,7 @@ Outcome run(bool correction, turbid::fsi::BoundaryKind boundary = turbid::fsi::B
   s.numerics.interface_correction = correction;
   s.numerics.boundary = boundary;
   s.output.vtk = false;
-  Simulation sim(s, {"cpu", 1});
+  Simulation sim(s, {"cpu", 0});
   sim.start();
   Outcome o;
   const double dx = s.particle_spacing;

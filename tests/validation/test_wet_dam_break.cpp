@@ -64,7 +64,7 @@ static void check_wet_dam_break(turbid::fsi::BoundaryKind boundary) {
   s.output.vtk = false;
   const double dx = s.particle_spacing;
   const auto& tank = s.walls.at(0).box;
-  Simulation sim(s, {"cpu", 1});
+  Simulation sim(s, {"cpu", 0});
   sim.start();
   const Totals start = totals(sim);
   ASSERT_EQ(start.count.size(), 2u);
