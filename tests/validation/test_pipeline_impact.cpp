@@ -1,0 +1,103 @@
+// Validation P (docs/validation.md, issue #21): the default scene, scenes/pipeline_impact_2d.yaml: a
+// Herschel-Bulkley debris flow runs down a slope under water, sheds a turbidity current and
+// strikes a pipeline (D = 0.1 m, gap D/2 above the bed).
+//
+// There is no measured drag for this layout (the scene's values are assumptions; the drag study is
+// tools/pipeline_study). What the run must satisfy, each against a reference:
+//  1. Archimedes: before the debris arrives the pipe sits in still water and feels rho_w g pi R^2 =
+//     77.05 N/m upward. Bound: the mean lift over 0.3-1.2 s within kBuoyancyTolerance of it
+//     (measured -8.6% at D/dx = 4, the CI spacing, where the gap under the pipe is two particle
+//     rows; +2.5% at D/dx = 6, full mode).
+//  2. Causality: the drag peak comes after the debris front (probe debris_front + dx/2) has reached
+//     the pipe's upstream face, and it stands above the still-water noise (the RMS of Fx over
+//     0.3-1.2 s) by more than a factor of 5 (measured 13.4 at D/dx = 4, 12.5 at D/dx = 6).
+//  3. Mass: splitting conserves mass (each daughter m/4): debris + turbidity mass (probes) constant
+//     to 1e-9 of it at every output, and the fluid's total mass to 1e-12.
+//  4. The transition happens: some of the debris has become turbidity by the end.
+// Quick mode (CI): the scene's spacing 0.025 m (D/dx = 4, about 2.5 minutes on 2 cores); full mode
+// (TURBID_FULL=1): 0.0166667 m (D/dx = 6, 7 minutes).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "validation_support.hpp"
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kRadius = 0.05;       // m, as in the scene
+constexpr double kPipeX = 1.7;         // m
+constexpr double kRhoWater = 1000.0;   // kg/m^3
+constexpr double kGravity = 9.81;      // m/s^2
+constexpr double kStillFrom = 0.3, kStillTo = 1.2;  // s: the pipe in still water
+
+}  // namespace
+
+TEST(ValidationPipelineImpact, DebrisFlowOnASuspendedPipeline2D) {
+  const bool full = turbid::validation::full_mode();
+  const double dx = full ? 0.1 / 6 : 0.025;
+  const double buoyancy_tolerance = full ? 0.05 : 0.12;
+  const auto run = turbid::validation::run_scene_file("pipeline_impact_2d", dx);
+  ASSERT_EQ(run.report.at("status").get<std::string>(), "completed") << run.report.dump(2);
+
+  auto forces = turbid::validation::read_csv(run.out / "forces.csv");
+  auto probes = turbid::validation::read_csv(run.out / "probes.csv");
+  const auto& t = forces["time [s]"];
+  const auto& fx = forces["pipe.Fx [N/m]"];
+  const auto& fy = forces["pipe.Fy [N/m]"];
+  ASSERT_GT(t.size(), 100u);
+  ASSERT_EQ(fx.size(), t.size());
+  ASSERT_EQ(fy.size(), t.size());
+
+  // 1. Archimedes in still water.
+  double lift = 0, noise = 0;
+  int n = 0;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    if (t[k] < kStillFrom || t[k] > kStillTo) continue;
+    lift += fy[k];
+    noise += fx[k] * fx[k];
+    ++n;
+  }
+  ASSERT_GT(n, 10);
+  lift /= n;
+  noise = std::sqrt(noise / n);
+  const double archimedes = kRhoWater * kGravity * kPi * kRadius * kRadius;
+  std::printf("[ measured ] dx = %g m: lift in still water %.2f N/m (Archimedes %.2f N/m, %+.1f%%), drag noise %.2f N/m\n",
+              dx, lift, archimedes, 100 * (lift / archimedes - 1), noise);
+  EXPECT_NEAR(lift, archimedes, buoyancy_tolerance * archimedes);
+
+  // 2. The drag peak after the debris arrives, well above the noise.
+  const auto peak = std::max_element(fx.begin(), fx.end()) - fx.begin();
+  const auto& pt = probes["time"];
+  const auto& front = probes["debris_front"];
+  double arrival = NAN;
+  for (std::size_t k = 0; k < pt.size(); ++k)
+    if (front[k] + 0.5 * dx >= kPipeX - kRadius) {
+      arrival = pt[k];
+      break;
+    }
+  std::printf("[ measured ] debris reaches the pipe at %.2f s; peak drag %.1f N/m at %.2f s (%.1f x the noise)\n", arrival,
+              fx[peak], t[peak], fx[peak] / noise);
+  ASSERT_TRUE(std::isfinite(arrival)) << "the debris never reached the pipe";
+  EXPECT_GE(t[peak], arrival - 0.05) << "the largest drag comes before the debris";
+  EXPECT_GT(fx[peak], 5 * noise);
+
+  // 3. Mass through the transition.
+  const auto& md = probes["debris_mass"];
+  const auto& mt = probes["turbidity_mass"];
+  ASSERT_EQ(md.size(), pt.size());
+  const double soil = md.front() + mt.front();
+  double worst = 0;
+  for (std::size_t k = 0; k < pt.size(); ++k) worst = std::max(worst, std::abs(md[k] + mt[k] - soil) / soil);
+  EXPECT_LT(worst, 1e-9) << "debris + turbidity mass";
+  EXPECT_LT(std::abs(run.report.at("fluid_mass_relative_change").get<double>()), 1e-12);
+
+  // 4. Some debris became turbidity.
+  std::printf("[ measured ] turbidity at the end: %.1f%% of the soil; %s splits\n", 100 * mt.back() / soil,
+              run.report.at("splits").dump().c_str());
+  EXPECT_GT(mt.back(), 0.01 * soil);
+  std::filesystem::remove_all(run.out);
+}
