@@ -1056,8 +1056,7 @@ void Simulation::resume(double time, std::uint64_t steps, std::uint64_t removed,
                         std::uint64_t checkpoint_index, std::uint64_t particle_steps) {
   solver_->resume(time, steps, removed);
   forces_index_ = 0;
-  if (scene_.output.forces_every > 0)
-    while (double(forces_index_) * scene_.output.forces_every <= time) ++forces_index_;
+  if (scene_.output.forces_every > 0) forces_index_ = next_index_after(time, scene_.output.forces_every, 0);
   output_index_ = output_index;
   checkpoint_index_ = checkpoint_index;
   particle_steps_ = particle_steps;
@@ -1133,8 +1132,7 @@ void Simulation::run(Observer& observer) {
   };
   auto write_forces = [&] {
     observer.on_forces(*this);
-    if (f_every > 0)
-      while (double(forces_index_) * f_every <= time()) ++forces_index_;
+    if (f_every > 0) forces_index_ = next_index_after(time(), f_every, forces_index_);
   };
   if (structures && time() == 0.0 && forces_index_ == 0) write_forces();
   const auto t0 = clock::now();
@@ -1150,11 +1148,10 @@ void Simulation::run(Observer& observer) {
     if (output_now) {
       sync_to_host();
       observer.on_output(*this);
-      if (every > 0)
-        while (double(output_index_) * every <= time()) ++output_index_;
+      if (every > 0) output_index_ = next_index_after(time(), every, output_index_);
     }
     if (ck_every > 0 && time() >= double(checkpoint_index_ + 1) * ck_every) {
-      while (double(checkpoint_index_ + 1) * ck_every <= time()) ++checkpoint_index_;
+      checkpoint_index_ = next_index_after(time(), ck_every, checkpoint_index_ + 1) - 1;
       sync_to_host();
       observer.on_checkpoint(*this);
     }
@@ -1165,6 +1162,18 @@ void Simulation::run(Observer& observer) {
   }
   sync_to_host();
   observer.on_finish(*this);
+}
+
+// The smallest k >= from with k * every > time: the index of the next output, force row or
+// checkpoint of a periodic schedule. Constant time whatever time / every is (a loop of ++k once
+// hung a run with every = 1e-300); a schedule past 2^63 entries is never due again.
+std::uint64_t next_index_after(double time, double every, std::uint64_t from) {
+  if (double(from) * every > time) return from;
+  const double q = std::floor(time / every);
+  if (!(q < 9.2e18)) return std::numeric_limits<std::uint64_t>::max();
+  std::uint64_t k = std::max(from, std::uint64_t(q));
+  while (double(k) * every <= time) ++k;  // one or two steps past the rounding of time / every
+  return k;
 }
 
 }  // namespace turbid::fsi

@@ -168,4 +168,8 @@ class Simulation {
   std::uint64_t particle_steps_ = 0;
 };
 
+// The smallest k >= from with k * every > time [s]: the index of the next entry of a periodic
+// output schedule, in constant time whatever time / every is.
+std::uint64_t next_index_after(double time, double every, std::uint64_t from);
+
 }  // namespace turbid::fsi

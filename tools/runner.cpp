@@ -291,6 +291,10 @@ void apply_overrides(fsi::Scene& scene, const RunRequest& r) {
     if (!(*r.checkpoint_every >= 0)) throw std::invalid_argument("--checkpoint-every must be >= 0 [s]");
     scene.output.checkpoint_every = *r.checkpoint_every;
   }
+  if (r.end_time || r.checkpoint_every) {
+    const std::string problem = schedule_problem(scene.end_time, scene.output);
+    if (!problem.empty()) throw std::invalid_argument("with the command-line options, " + problem);
+  }
 }
 
 std::string describe_scene(const fsi::Scene& scene) {

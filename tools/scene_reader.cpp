@@ -11,6 +11,7 @@
 #include "tools/path_csv.hpp"
 
 #include <yaml-cpp/yaml.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -27,6 +28,7 @@
 #include <optional>
 #include <sstream>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 namespace turbid::tools {
@@ -109,6 +111,27 @@ std::string choices_text(const std::vector<std::string>& options) {
 std::string fmt(double v) {
   std::ostringstream s;
   s << std::setprecision(12) << v;
+  return s.str();
+}
+
+// The most particles a scene can hold: ids are 32-bit.
+constexpr double kMaxParticles = 4294967295.0;
+
+// The least memory a particle takes (its fields, before neighbour lists), to refuse a scene that
+// cannot fit before allocating it [bytes]; `turbid check` prints the scene's own figure.
+constexpr double kMinBytesPerParticle = 100.0;
+
+// Physical memory of this machine [bytes], 0 where unknown.
+double physical_memory_bytes() {
+  const long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && size > 0 ? double(pages) * double(size) : 0.0;
+}
+
+// "4 x 1e+308" (2D) or "4 x 1 x 2" (3D): a box's extents along its axes [m].
+std::string extent_text(const fsi::Box& b, int dims) {
+  std::ostringstream s;
+  s << std::setprecision(6);
+  for (int k = 0; k < dims; ++k) s << (k ? " x " : "") << (b.max[k] - b.min[k]);
   return s.str();
 }
 
@@ -198,6 +221,7 @@ class MapView {
   const Reader& reader_;
   Value value_;
   std::vector<std::string> allowed_;
+  std::unordered_map<std::string, std::size_t> index_;  // key -> entry: linear time in the keys
   std::vector<Entry> entries_;
 };
 
@@ -409,6 +433,7 @@ MapView::MapView(const Reader& reader, Value value, std::vector<std::string> all
     if (const Entry* first = find(key))
       reader_.fail(k.Mark(), "duplicate key '" + key + "' in " + value_.name + " (first given at line " +
                                  std::to_string(first->key_mark.line + 1) + ")");
+    index_.emplace(key, entries_.size());
     entries_.push_back({key, k.Mark(), it->second});
   }
   if (check_keys_now) check_keys();
@@ -429,9 +454,8 @@ void MapView::check_keys() const {
 }
 
 const MapView::Entry* MapView::find(std::string_view key) const {
-  for (const Entry& e : entries_)
-    if (e.key == key) return &e;
-  return nullptr;
+  const auto it = index_.find(std::string(key));
+  return it == index_.end() ? nullptr : &entries_[it->second];
 }
 
 Value MapView::entry_value(const Entry& e, std::string name) const {
@@ -540,7 +564,11 @@ fsi::Scene Reader::read(const std::string& yaml_text) {
                                        "scene has no 'transitions'");
       read_capacity(*v, scene.capacity);
     }
-    if (auto v = top.get("output")) read_output(*v, scene.output);
+    if (auto v = top.get("output")) {
+      read_output(*v, scene.output);
+      const std::string problem = schedule_problem(scene.end_time, scene.output);
+      if (!problem.empty()) fail(v->mark, problem);
+    }
   } catch (const YAML::Exception& e) {
     // Walking a parsed tree should not throw; if yaml-cpp does, keep the promised message form.
     fail(e.mark, "cannot read the scene: " + e.msg);
@@ -793,6 +821,7 @@ void Reader::read_walls(const Value& v, fsi::Scene& scene, std::vector<YAML::Mar
 }
 
 void Reader::read_fluids(const Value& v, fsi::Scene& scene, const std::vector<YAML::Mark>& wall_marks) const {
+  double fluid_sites = 0;  // lattice sites over the blocks' bounding boxes so far
   const int dims = scene.dimensions;
   const double dx = scene.particle_spacing;
   const double tol = 1e-9 * dx;
@@ -849,6 +878,29 @@ void Reader::read_fluids(const Value& v, fsi::Scene& scene, const std::vector<YA
         fail(bv.mark, "the fluid 'box' is " + fmt(extent) + " m wide along " + kAxisName[k] +
                           ", less than particle_spacing = " + fmt(dx) +
                           " m, so it would hold fewer than one particle per axis");
+    }
+    {
+      // The lattice over the block's bounding box is what building the particles walks: bound it
+      // before anything loops over it (a vertex at 1e308 once made 'turbid check' spin for minutes).
+      // Particle ids are 32-bit, so no scene can hold more than 2^32 - 1 particles in all.
+      double sites = 1;
+      for (int k = 0; k < dims; ++k) sites *= std::floor((b.max[k] - b.min[k]) / dx) + 1;
+      fluid_sites += sites;
+      const double memory = physical_memory_bytes();
+      const bool too_many = !(fluid_sites <= kMaxParticles);
+      if (too_many || (memory > 0 && fluid_sites * kMinBytesPerParticle > memory)) {
+        std::ostringstream os;
+        os << std::setprecision(3);
+        if (std::isfinite(fluid_sites)) os << "about " << fluid_sites;
+        else os << "more than 1e308";
+        os << " particles at particle_spacing = " << fmt(dx) << " m"
+           << (scene.fluids.empty() ? "" : " with the blocks before it") << ", more than ";
+        if (too_many) os << "the 4294967295 (2^32 - 1) a scene can hold";
+        else os << "this machine's memory holds (" << fluid_sites * kMinBytesPerParticle / 1073741824.0 << " GiB at "
+                << kMinBytesPerParticle << " bytes a particle or more, against " << memory / 1073741824.0 << " GiB)";
+        fail(bv.mark, "the fluid " + std::string(block.polygon.empty() ? "'box'" : "'polygon'") + " spans " +
+                          extent_text(b, dims) + " m: " + os.str() + "; check the coordinates or the spacing");
+      }
     }
     for (std::size_t w = 0; w < scene.walls.size(); ++w) {
       const fsi::WallSpec& wall = scene.walls[w];
@@ -1469,6 +1521,27 @@ void Reader::read_output(const Value& v, fsi::OutputSpec& out) const {
 }
 
 }  // namespace
+
+std::string schedule_problem(double end, const fsi::OutputSpec& out) {
+  struct Item {
+    double every;
+    double most;
+    const char* key;
+    const char* what;
+  };
+  const Item items[] = {{out.every, 1e6, "output: every", "ParaView frames"},
+                        {out.forces_every, 1e8, "output: forces_every", "force rows"},
+                        {out.checkpoint_every, 1e5, "checkpoint_every", "checkpoints"}};
+  for (const Item& it : items) {
+    if (!(it.every > 0) || end / it.every <= it.most) continue;
+    std::ostringstream os;
+    os << std::setprecision(3) << "'" << it.key << "' = " << it.every << " s over an end time of " << end
+       << " s asks for " << end / it.every << " " << it.what << ", more than " << it.most
+       << "; give at least " << end / it.most << " s (0 for none)";
+    return os.str();
+  }
+  return {};
+}
 
 fsi::Scene read_scene_string(const std::string& yaml_text, const std::string& file_name_for_messages) {
   return Reader(file_name_for_messages).read(yaml_text);

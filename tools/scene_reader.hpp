@@ -28,4 +28,11 @@ fsi::Scene read_scene_file(const std::string& path, const std::string& relative_
 // Scene::source_file.
 fsi::Scene read_scene_string(const std::string& yaml_text, const std::string& file_name_for_messages);
 
+// Where an output schedule of the run would write more entries than anyone could use (VTK frames
+// every `output.every`, force rows every `forces_every`, checkpoints every `checkpoint_every`, each
+// over `end` seconds), the reason in words naming `key`; empty where it is fine. The scene reader
+// and the command-line overrides both ask it, so neither can start a run that never gets past its
+// first outputs.
+std::string schedule_problem(double end, const fsi::OutputSpec& out);
+
 }  // namespace turbid::tools

@@ -88,3 +88,24 @@ output: {every: 0.05, vtk: false}
   EXPECT_EQ(report.at("particles_end").get<int>(), 0);
   fs::remove_all(dir);
 }
+
+// Issue #27: '--checkpoint-every 1e-300' passed and the run hung after its first step. The
+// command-line schedule goes through the scene's own bound and is refused, naming the option's key.
+TEST(RunFailures, ACheckpointIntervalNoRunCouldHonourIsRefused) {
+  turbid::fsi::Scene scene;
+  scene.end_time = 0.25;
+  turbid::tools::RunRequest request;
+  request.checkpoint_every = 1e-300;
+  try {
+    turbid::tools::apply_overrides(scene, request);
+    ADD_FAILURE() << "no error for --checkpoint-every 1e-300";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'checkpoint_every' = 1e-300 s over an end time of 0.25 s asks for 2.5e+299 "
+                                         "checkpoints, more than 1e+05"),
+              std::string::npos)
+        << e.what();
+  }
+  request.checkpoint_every = 0.01;  // 25 checkpoints: fine
+  EXPECT_NO_THROW(turbid::tools::apply_overrides(scene, request));
+  EXPECT_DOUBLE_EQ(scene.output.checkpoint_every, 0.01);
+}

@@ -5,6 +5,9 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
+#include <cstdint>
+#include <limits>
 #include <cctype>
 #include <filesystem>
 #include <set>
@@ -194,6 +197,10 @@ const BadScene kBadScenes[] = {
      "a path held at a first sample away from the scene position (the fluid is carved around that position)"},
     {"prescribed_mass.yaml", 11, 90, "'mass' applies to a free structure; structure 'cylinder' is prescribed",
      "a free body's key on a prescribed structure is not ignored"},
+    {"huge_polygon.yaml", 11, 32, "more than 1e308 particles at particle_spacing = 0.01 m",
+     "a vertex at 1e308 is refused before any loop walks its lattice (issue #27: check spun for minutes)"},
+    {"output_every_tiny.yaml", 10, 9, "'output: every' = 1e-300 s over an end time of 1 s asks for 1e+300 ParaView",
+     "an output interval that no run could honour (issue #27: the run hung after its first step)"},
 };
 
 class SceneReaderBadFile : public ::testing::TestWithParam<BadScene> {};
@@ -578,4 +585,41 @@ TEST(SceneReader, PrescribedPathCsvErrorsNameTheCsvLineAndColumn) {
     EXPECT_EQ(message.rfind(prefix, 0), 0u) << "expected prefix: " << prefix << "\n  got: " << message;
     EXPECT_NE(message.find(c.phrase), std::string::npos) << "expected phrase: " << c.phrase << "\n  got: " << message;
   }
+}
+
+// Issue #27: checking was quadratic in the number of keys (32,000 unknown keys took 28 s) because
+// each key was searched for among those before it. A duplicate after 100,000 distinct keys must
+// still be found, named and located, and (a hang detector, not a speed target: the linear reader
+// takes about 0.5 s here, the quadratic one several minutes) within 60 s on a shared machine.
+TEST(SceneReader, ManyKeysAreCheckedInLinearTime) {
+  std::string yaml =
+      "name: many\ndimensions: 2\nresolution: {particle_spacing: 0.01}\ntime: {end: 1.0}\nmaterials:\n";
+  const int n = 100000;
+  for (int i = 0; i < n; ++i) yaml += "  m" + std::to_string(i) + ": {density: 1000}\n";
+  yaml += "  m17: {density: 1000}\n";
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string message = error_of_string(yaml);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_NE(message.find("inline.yaml:" + std::to_string(n + 6) + ":3: error: duplicate key 'm17'"), std::string::npos)
+      << message;
+  EXPECT_NE(message.find("first given at line 23"), std::string::npos) << message;
+  EXPECT_LT(seconds, 60.0);
+}
+
+// The schedule index (outputs, force rows, checkpoints) agrees with counting up one by one, and
+// takes constant time where counting would not end (every = 1e-300 s once hung a run).
+TEST(OutputSchedule, NextIndexMatchesCountingAndNeverLoops) {
+  using turbid::fsi::next_index_after;
+  for (double every : {0.1, 0.01, 1.0 / 3.0, 0.005, 0.25})
+    for (int i = 0; i <= 400; ++i) {
+      const double time = i * 0.0037 + (i % 7) * every;  // includes times that land on k * every
+      for (std::uint64_t from : {std::uint64_t(0), std::uint64_t(3)}) {
+        std::uint64_t k = from;
+        while (double(k) * every <= time) ++k;
+        EXPECT_EQ(next_index_after(time, every, from), k) << "time " << time << " every " << every;
+      }
+    }
+  EXPECT_EQ(next_index_after(0.3, 0.1, 0), 3u);  // 3 * 0.1 = 0.30000000000000004 > 0.3
+  EXPECT_EQ(next_index_after(1.0, 1e-300, 0), std::numeric_limits<std::uint64_t>::max());
+  EXPECT_EQ(next_index_after(1.0, 1e-9, 0), 1000000001u);
 }
