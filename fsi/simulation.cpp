@@ -1053,13 +1053,14 @@ double Simulation::particle_steps_per_second() const {
 void Simulation::start() { solver_->start(); }
 
 void Simulation::resume(double time, std::uint64_t steps, std::uint64_t removed, std::uint64_t output_index,
-                        std::uint64_t checkpoint_index, std::uint64_t particle_steps) {
+                        std::uint64_t checkpoint_index, std::uint64_t particle_steps, double wall_seconds) {
   solver_->resume(time, steps, removed);
   forces_index_ = 0;
   if (scene_.output.forces_every > 0) forces_index_ = next_index_after(time, scene_.output.forces_every, 0);
   output_index_ = output_index;
   checkpoint_index_ = checkpoint_index;
   particle_steps_ = particle_steps;
+  wall_seconds_ = wall_seconds;  // the whole run's, so its rate counts the steps and time before the resume alike
 }
 
 void Simulation::step() {
@@ -1113,6 +1114,7 @@ std::vector<double> Simulation::probe_values() {
 
 void Simulation::run(Observer& observer) {
   using clock = std::chrono::steady_clock;
+  interrupted_ = false;
   const double every = scene_.output.every;
   const double ck_every = scene_.output.checkpoint_every;
   // Output k is due at time k * every; the first step at or past that time writes it.
@@ -1158,6 +1160,12 @@ void Simulation::run(Observer& observer) {
     if (std::chrono::duration<double>(now - last_progress).count() >= 0.5 || last) {
       observer.on_progress(*this);
       last_progress = now;
+    }
+    if (!last && observer.stop_requested()) {
+      interrupted_ = true;
+      sync_to_host();
+      observer.on_checkpoint(*this);
+      break;
     }
   }
   sync_to_host();

@@ -66,6 +66,9 @@ class Observer {
   virtual void on_progress(const Simulation&) {}  // about twice a second of wall time
   virtual void on_forces(Simulation&) {}          // every forces interval (scenes with structures)
   virtual void on_finish(Simulation&) {}
+  // Polled after each step's outputs; true ends the run there, after an on_checkpoint (the
+  // runner answers Ctrl-C and SIGTERM this way, so the work up to that step is kept).
+  virtual bool stop_requested() const { return false; }
 };
 
 // The mass properties of a free structure: from its filled sampling at the scene's spacing and its
@@ -126,10 +129,12 @@ class Simulation {
   // Fresh start: forces at t = 0. Or continue after the store was filled from a checkpoint.
   void start();
   void resume(double time, std::uint64_t steps, std::uint64_t removed, std::uint64_t output_index,
-              std::uint64_t checkpoint_index, std::uint64_t particle_steps);
+              std::uint64_t checkpoint_index, std::uint64_t particle_steps, double wall_seconds = 0);
 
   // Runs to the end time; throws sph::BlowUp (after telling no observer) on a numerical failure.
   void run(Observer& observer);
+  // The last run() ended early because its observer asked it to stop.
+  bool interrupted() const { return interrupted_; }
   void step();
 
   std::vector<double> probe_values();  // evaluated now (synchronises the store)
@@ -166,6 +171,7 @@ class Simulation {
   std::uint64_t checkpoint_index_ = 0;
   std::uint64_t forces_index_ = 0;
   std::uint64_t particle_steps_ = 0;
+  bool interrupted_ = false;
 };
 
 // The smallest k >= from with k * every > time [s]: the index of the next entry of a periodic

@@ -3,11 +3,14 @@
 
 #include <unistd.h>
 
+#include <csignal>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -167,6 +170,43 @@ MaterialTotals material_totals(const fsi::Simulation& sim) {
   return t;
 }
 
+// Ctrl-C (SIGINT) and SIGTERM during a run: the first asks the run to stop after the current step
+// with a checkpoint and run.json; a second ends the process at once (exit 128 + signal).
+volatile std::sig_atomic_t g_stop_signal = 0;
+
+extern "C" void on_stop_signal(int signo) {
+  if (g_stop_signal != 0) {
+    static const char msg[] = "\nturbid: second signal, exiting now without a checkpoint\n";
+    [[maybe_unused]] const auto n = write(STDERR_FILENO, msg, sizeof msg - 1);
+    _exit(128 + signo);
+  }
+  g_stop_signal = signo;
+}
+
+// Installs the handlers for one run and puts the previous ones back after it.
+class StopSignals {
+ public:
+  StopSignals() {
+    g_stop_signal = 0;
+    struct sigaction sa {};
+    sa.sa_handler = on_stop_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &old_int_);
+    sigaction(SIGTERM, &sa, &old_term_);
+  }
+  ~StopSignals() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+  int received() const { return g_stop_signal; }
+
+ private:
+  struct sigaction old_int_ {};
+  struct sigaction old_term_ {};
+};
+
 class Writers final : public fsi::Observer {
  public:
   Writers(const fs::path& out, const fsi::Scene& scene, std::optional<double> resume_time, bool progress)
@@ -193,6 +233,11 @@ class Writers final : public fsi::Observer {
 
   void on_checkpoint(fsi::Simulation& sim) override { save_checkpoint(sim); }
 
+  bool stop_requested() const override {
+    if (g_stop_signal != 0 && progress_ && tty_) std::fprintf(stderr, "\n");
+    return g_stop_signal != 0;
+  }
+
   void on_progress(const fsi::Simulation& sim) override {
     // Splits refused for lack of room: said once per new batch, whatever the progress setting.
     if (sim.split_totals().refused > refused_told_) {
@@ -202,9 +247,10 @@ class Writers final : public fsi::Observer {
       refused_told_ = sim.split_totals().refused;
     }
     if (!progress_) return;
-    const double rate = sim.particle_steps_per_second();
     const double frac = sim.time() / sim.end_time();
     const double elapsed = sim.wall_seconds() - wall_at_start_;
+    // This process's rate (after a resume the steps before it ran in another process's time).
+    const double rate = elapsed > 0 ? double(sim.particle_steps() - particle_steps_at_start_) / elapsed : 0.0;
     const double done = sim.time() - time_at_start_;
     const double left = std::max(0.0, sim.end_time() - sim.time());
     const double eta = left == 0 ? 0.0 : done > 0 ? elapsed * left / done : NAN;
@@ -254,6 +300,7 @@ class Writers final : public fsi::Observer {
 
   void start_clock(const fsi::Simulation& sim) {
     wall_at_start_ = sim.wall_seconds();
+    particle_steps_at_start_ = sim.particle_steps();
     time_at_start_ = sim.time();
   }
 
@@ -264,6 +311,7 @@ class Writers final : public fsi::Observer {
   double last_plain_ = 0;
   std::size_t refused_told_ = 0;  // splits refused that a warning has reported
   double wall_at_start_ = 0, time_at_start_ = 0;
+  std::uint64_t particle_steps_at_start_ = 0;
   std::optional<CsvSeriesWriter> probes_;
   std::optional<CsvSeriesWriter> forces_;
   std::optional<VtkSeriesWriter> vtk_;
@@ -475,6 +523,31 @@ nlohmann::json run_scene(const RunRequest& request) {
     scene = read_scene_file(request.scene_file.string());
   }
   apply_overrides(scene, request);
+  if (resume_time && !(scene.end_time > *resume_time)) {
+    // Nothing to run: say so and leave the run directory (and its run.json) as it is.
+    std::ostringstream os;
+    os << std::setprecision(6);
+    if (request.end_time)
+      os << "--end " << scene.end_time << " s is not past the time of the checkpoint in " << request.resume->string()
+         << " (t = " << *resume_time << " s); give a later end time";
+    else
+      os << "the run in " << request.resume->string() << " already reached its end time (t = " << *resume_time
+         << " s): nothing to resume; add --end T with T > " << *resume_time << " s to continue it further";
+    throw std::invalid_argument(os.str());
+  }
+  if (resume_time) {
+    // A run that completed (its run.json says so) up to the end asked for: nothing to do either.
+    std::ifstream in(*request.resume / "run.json");
+    const nlohmann::json last = in ? nlohmann::json::parse(in, nullptr, false) : nlohmann::json();
+    if (last.is_object() && last.value("status", std::string()) == "completed" &&
+        last.value("simulated_time", 0.0) >= scene.end_time) {
+      std::ostringstream os;
+      os << std::setprecision(6) << "the run in " << request.resume->string() << " already finished at t = "
+         << last.value("simulated_time", 0.0) << " s (its run.json): nothing to resume up to " << scene.end_time
+         << " s; add --end T with a later T to continue it from its checkpoint (t = " << *resume_time << " s)";
+      throw std::invalid_argument(os.str());
+    }
+  }
   fs::create_directories(out);
   if (!request.resume) {
     // Keep the scene beside its results so that a run can be resumed and reproduced.
@@ -535,12 +608,18 @@ nlohmann::json run_scene(const RunRequest& request) {
                      {"surface_area", scene.dimensions == 2 ? "m" : "m^2"},
                      {"volume", scene.dimensions == 2 ? "m^2" : "m^3"}};
   std::string status = "completed";
+  struct {
+    double time = 0;
+    std::uint64_t steps = 0, particle_steps = 0;
+    double wall_seconds = 0;
+  } segment_start;
   try {
     if (request.resume) {
       const auto state = read_checkpoint(*request.resume / "checkpoint", sim.store());
       sim.resume(state.at("time").get<double>(), state.at("steps").get<std::uint64_t>(),
                  state.at("removed").get<std::uint64_t>(), state.at("output_index").get<std::uint64_t>(),
-                 state.at("checkpoint_index").get<std::uint64_t>(), state.at("particle_steps").get<std::uint64_t>());
+                 state.at("checkpoint_index").get<std::uint64_t>(), state.at("particle_steps").get<std::uint64_t>(),
+                 state.value("wall_seconds", 0.0));
       sim.restore_open_boundary_counts(state.value("inflow", std::uint64_t(0)), state.value("outflow", std::uint64_t(0)));
       sph::SplitCounts splits;
       splits.splits = state.value("splits", std::size_t(0));
@@ -553,7 +632,15 @@ nlohmann::json run_scene(const RunRequest& request) {
       sim.start();
     }
     writers.start_clock(sim);
+    segment_start = {sim.time(), sim.steps(), sim.particle_steps(), sim.wall_seconds()};
+    const StopSignals signals;
     sim.run(writers);
+    if (sim.interrupted()) {
+      status = "interrupted";
+      report["signal"] = signals.received() == SIGINT ? "SIGINT" : "SIGTERM";
+      report["signal_number"] = signals.received();
+      report["checkpoint"] = (out / "checkpoint").string();
+    }
   } catch (const sph::BlowUp& e) {
     status = "blow-up";
     report["error"] = e.what();
@@ -594,6 +681,16 @@ nlohmann::json run_scene(const RunRequest& request) {
   report["simulated_time"] = sim.time();
   report["wall_seconds"] = sim.wall_seconds();
   report["particle_steps_per_second"] = sim.particle_steps_per_second();
+  if (request.resume) {
+    // The whole run's figures above count the segments before the checkpoint too (their wall time
+    // is stored in it); this segment's own, this process only:
+    const double seg_wall = sim.wall_seconds() - segment_start.wall_seconds;
+    const std::uint64_t seg_ps = sim.particle_steps() - segment_start.particle_steps;
+    report["segment"] = {{"from_time", segment_start.time},
+                         {"steps", sim.steps() - segment_start.steps},
+                         {"wall_seconds", seg_wall},
+                         {"particle_steps_per_second", seg_wall > 0 ? double(seg_ps) / seg_wall : 0.0}};
+  }
   report["fluid_mass_start"] = mass_start;
   report["fluid_mass_end"] = mass_end;
   report["fluid_mass_relative_change"] = (mass_end - mass_start) / mass_start;

@@ -91,6 +91,15 @@ int main(int argc, char** argv) {
     }
     const auto report = turbid::tools::run_scene(req);
     const std::string dir = req.out.empty() ? resume : req.out.string();
+    if (report.at("status") == "interrupted") {
+      // Ctrl-C or SIGTERM: the run stopped after a step with a checkpoint; exit 128 + the signal.
+      const int signo = report.at("signal_number").get<int>();
+      std::fprintf(stderr, "turbid: %s at t = %.6g s (step %llu): checkpoint and run.json written in %s\n",
+                   report.at("signal").get<std::string>().c_str(), report.at("simulated_time").get<double>(),
+                   static_cast<unsigned long long>(report.at("steps").get<std::uint64_t>()), dir.c_str());
+      std::fprintf(stderr, "turbid: continue with: turbid run --resume %s\n", dir.c_str());
+      return 128 + signo;
+    }
     if (report.at("status") != "completed") {
       std::fprintf(stderr, "turbid: error: %s\n", report.value("error", std::string("run failed")).c_str());
       std::fprintf(stderr, "turbid: outputs up to the failure are in %s\n", dir.c_str());
