@@ -170,6 +170,76 @@ MaterialTotals material_totals(const fsi::Simulation& sim) {
   return t;
 }
 
+// The run's state block: every key the resume reads, of the type it reads, so that an edited or
+// damaged value is named with its file and key (not a bare json type_error).
+void check_run_state(const nlohmann::json& state, const fs::path& file) {
+  const auto bad = [&](const fs::path& f, const std::string& what) {
+    throw std::runtime_error("checkpoint '" + f.string() + "': " + what);
+  };
+  if (!state.is_object()) bad(file, "'state' must be an object, got " + std::string(state.type_name()));
+  struct Key {
+    const char* name;
+    bool required;
+    bool count;  // a non-negative integer; else any number
+  };
+  const Key keys[] = {{"time", true, false},           {"steps", true, true},           {"removed", true, true},
+                      {"output_index", true, true},    {"checkpoint_index", true, true}, {"particle_steps", true, true},
+                      {"particle_spacing", true, false}, {"end_time", true, false},      {"wall_seconds", false, false},
+                      {"inflow", false, true},         {"outflow", false, true},        {"splits", false, true},
+                      {"daughters", false, true},      {"splits_refused", false, true},
+                      {"smallest_smoothing_length", false, false}, {"checkpoint_every", false, false}};
+  for (const Key& k : keys) {
+    if (!state.contains(k.name)) {
+      if (k.required) bad(file, "'state' has no '" + std::string(k.name) + "'");
+      continue;
+    }
+    const nlohmann::json& v = state[k.name];
+    const bool ok = k.count ? v.is_number_unsigned() : v.is_number();
+    if (!ok)
+      bad(file, "'state." + std::string(k.name) + "' must be " + (k.count ? "a non-negative integer" : "a number") +
+                    ", got " + v.dump() + " (" + v.type_name() + ")");
+  }
+  for (const char* k : {"scene_directory"})
+    if (state.contains(k) && !state[k].is_string())
+      bad(file, "'state." + std::string(k) + "' must be a string, got " + state[k].dump());
+  if (state.contains("inputs") && !state["inputs"].is_object())
+    bad(file, "'state.inputs' must be an object of file hashes, got " + state["inputs"].dump());
+}
+
+// FNV-1a (64 bit) of a file's bytes as 16 hex digits: tells a changed input from the one a
+// checkpoint was written with (a change detector, not a defence against tampering).
+std::string file_hash(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read '" + file.string() + "'");
+  std::uint64_t h = 14695981039346656037ull;
+  char buf[1 << 16];
+  while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+    for (std::streamsize i = 0; i < in.gcount(); ++i) {
+      h ^= static_cast<unsigned char>(buf[i]);
+      h *= 1099511628211ull;
+    }
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  return hex;
+}
+
+// The files a run's physics comes from: its scene.yaml and every mesh and path CSV it names, each
+// with its hash, keyed by the name the scene gives it.
+nlohmann::json input_hashes(const fs::path& scene_yaml, const fsi::Scene& scene) {
+  nlohmann::json j = nlohmann::json::object();
+  j["scene.yaml"] = file_hash(scene_yaml);
+  for (const auto& st : scene.structures) {
+    if (!st.resolved_file.empty()) j[st.file] = file_hash(st.resolved_file);
+    if (!st.path.source.empty()) {
+      fs::path q = st.path.source;
+      if (q.is_relative() && !fs::exists(q) && !scene.base_directory.empty()) q = fs::path(scene.base_directory) / q;
+      j[st.path.source] = file_hash(q);
+    }
+  }
+  return j;
+}
+
 // Ctrl-C (SIGINT) and SIGTERM during a run: the first asks the run to stop after the current step
 // with a checkpoint and run.json; a second ends the process at once (exit 128 + signal).
 volatile std::sig_atomic_t g_stop_signal = 0;
@@ -289,6 +359,8 @@ class Writers final : public fsi::Observer {
       state["smallest_smoothing_length"] = c.smallest_h;
     }
     state["wall_seconds"] = sim.wall_seconds();
+    state["checkpoint_every"] = sim.scene().output.checkpoint_every;  // a --checkpoint-every outlives the resume
+    state["inputs"] = inputs_;  // hashes of the scene and its files: a resume refuses changed physics
     state["particle_spacing"] = sim.scene().particle_spacing;
     state["end_time"] = sim.scene().end_time;
     // Meshes named relative to the scene file are found from here when the run is resumed.
@@ -297,6 +369,8 @@ class Writers final : public fsi::Observer {
     if (sim.bodies() && sim.bodies()->contacts()) state["contacts"] = contact_states(sim);
     write_checkpoint(out_ / "checkpoint", sim.store(), state);
   }
+
+  void set_inputs(nlohmann::json inputs) { inputs_ = std::move(inputs); }
 
   void start_clock(const fsi::Simulation& sim) {
     wall_at_start_ = sim.wall_seconds();
@@ -312,6 +386,7 @@ class Writers final : public fsi::Observer {
   std::size_t refused_told_ = 0;  // splits refused that a warning has reported
   double wall_at_start_ = 0, time_at_start_ = 0;
   std::uint64_t particle_steps_at_start_ = 0;
+  nlohmann::json inputs_ = nlohmann::json::object();
   std::optional<CsvSeriesWriter> probes_;
   std::optional<CsvSeriesWriter> forces_;
   std::optional<VtkSeriesWriter> vtk_;
@@ -515,10 +590,30 @@ nlohmann::json run_scene(const RunRequest& request) {
     if (!fs::exists(saved_scene))
       throw std::runtime_error(saved_scene.string() + ": not found (is " + dir.string() + " a turbid run directory?)");
     ck_state = read_checkpoint_state(dir / "checkpoint");
+    check_run_state(ck_state, dir / "checkpoint" / "checkpoint.json");
     scene = read_scene_file(saved_scene.string(), ck_state.value("scene_directory", std::string()));
     scene.particle_spacing = ck_state.at("particle_spacing").get<double>();
     scene.end_time = ck_state.at("end_time").get<double>();
     resume_time = ck_state.at("time").get<double>();
+    if (ck_state.contains("checkpoint_every")) scene.output.checkpoint_every = ck_state["checkpoint_every"].get<double>();
+    if (ck_state.contains("inputs")) {
+      // The physics must be the checkpoint's: an edited scene.yaml (a sound speed, a wall) or mesh
+      // once resumed silently with different physics.
+      const nlohmann::json now = input_hashes(saved_scene, scene);
+      for (const auto& [name, hash] : ck_state["inputs"].items()) {
+        const std::string current = now.contains(name) ? now[name].get<std::string>() : std::string("(not named now)");
+        if (current != hash)
+          throw std::runtime_error("cannot resume " + dir.string() + ": '" + name +
+                                   "' is not the file its checkpoint was written with (hash " + hash.get<std::string>() +
+                                   ", now " + current + "); the run would go on with different physics. Put it back "
+                                   "as it was, or start a new run");
+      }
+      for (const auto& [name, hash] : now.items())
+        if (!ck_state["inputs"].contains(name))
+          throw std::runtime_error("cannot resume " + dir.string() + ": the scene now names '" + name +
+                                   "', which its checkpoint was not written with; put scene.yaml back as it was, or "
+                                   "start a new run");
+    }
   } else {
     scene = read_scene_file(request.scene_file.string());
   }
@@ -552,7 +647,10 @@ nlohmann::json run_scene(const RunRequest& request) {
   if (!request.resume) {
     // Keep the scene beside its results so that a run can be resumed and reproduced.
     const std::string text = read_text(request.scene_file);
-    std::ofstream(out / "scene.yaml", std::ios::binary) << text;
+    std::ofstream copy(out / "scene.yaml", std::ios::binary);
+    copy << text;
+    copy.close();
+    if (!copy) throw std::runtime_error("cannot write " + (out / "scene.yaml").string() + " (disk full or not writable?)");
   } else if (fs::absolute(out) != fs::absolute(*request.resume)) {
     fs::copy_file(*request.resume / "scene.yaml", out / "scene.yaml", fs::copy_options::overwrite_existing);
   }
@@ -566,6 +664,8 @@ nlohmann::json run_scene(const RunRequest& request) {
   const std::vector<double> momentum_start = fluid_momentum(sim);
   const MaterialTotals materials_start = material_totals(sim);
   Writers writers(out, sim.scene(), resume_time, request.progress);
+  writers.set_inputs(request.resume && ck_state.contains("inputs") ? ck_state["inputs"]
+                                                                  : input_hashes(out / "scene.yaml", sim.scene()));
   if (request.progress) {
     std::string gpu;
     const bool on_gpu = sim.backend_name() == "cuda" && sph::cuda_device_count(&gpu) > 0;

@@ -7,6 +7,7 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <thread>
 
 #include "tools/runner.hpp"
@@ -148,7 +149,47 @@ output: {every: 0.01}
   EXPECT_EQ(written.at("status"), "interrupted");
   EXPECT_TRUE(fs::exists(dir / "out" / "checkpoint"));
 
+  // A checkpoint belongs to its scene (issue #27 item 5): an edited scene.yaml is refused, naming
+  // it; so is a state value of the wrong type, naming the file and key.
+  const fs::path saved = dir / "out" / "scene.yaml";
+  std::string text;
+  {
+    std::ifstream f(saved);
+    text.assign(std::istreambuf_iterator<char>(f), {});
+  }
+  std::ofstream(saved) << std::string(text).replace(text.find("sound_speed: 20"), 15, "sound_speed: 25");
   turbid::tools::RunRequest r;
+  r.resume = dir / "out";
+  r.out = dir / "out";
+  r.backend = "cpu";
+  r.progress = false;
+  try {
+    turbid::tools::run_scene(r);
+    ADD_FAILURE() << "an edited scene.yaml resumed";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("'scene.yaml' is not the file its checkpoint was written with"),
+              std::string::npos) << e.what();
+  }
+  std::ofstream(saved) << text;
+  const fs::path meta = dir / "out" / "checkpoint" / "checkpoint.json";
+  std::string meta_text;
+  {
+    std::ifstream f(meta);
+    meta_text.assign(std::istreambuf_iterator<char>(f), {});
+  }
+  auto edited = nlohmann::json::parse(meta_text);
+  edited["state"]["time"] = "soon";
+  std::ofstream(meta) << edited.dump(2);
+  try {
+    turbid::tools::run_scene(r);
+    ADD_FAILURE() << "a string time resumed";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("checkpoint.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'state.time' must be a number, got \"soon\""), std::string::npos) << e.what();
+  }
+  std::ofstream(meta) << meta_text;
+
+  r = {};
   r.resume = dir / "out";
   r.out = dir / "out";
   r.backend = "cpu";
