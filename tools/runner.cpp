@@ -206,6 +206,22 @@ void check_run_state(const nlohmann::json& state, const fs::path& file) {
     bad(file, "'state.inputs' must be an object of file hashes, got " + state["inputs"].dump());
 }
 
+// What a run that died while writing leaves in its directory: half-written files (`*.tmp-PID`,
+// tools/atomic_file), a half-written `checkpoint.tmp/`, and `checkpoint.old/` once `checkpoint/` is
+// complete (while `checkpoint/` is missing, `checkpoint.old/` is the checkpoint and stays).
+void remove_leftovers(const fs::path& out) {
+  std::error_code ec;
+  for (const fs::path& d : {out, out / "checkpoint"}) {
+    if (!fs::is_directory(d, ec)) continue;
+    std::vector<fs::path> stale;
+    for (const auto& e : fs::directory_iterator(d, ec))
+      if (e.path().filename().string().find(".tmp-") != std::string::npos) stale.push_back(e.path());
+    for (const auto& p : stale) fs::remove_all(p, ec);
+  }
+  fs::remove_all(out / "checkpoint.tmp", ec);
+  if (fs::exists(out / "checkpoint" / "checkpoint.json", ec)) fs::remove_all(out / "checkpoint.old", ec);
+}
+
 // FNV-1a (64 bit) of a file's bytes as 16 hex digits: tells a changed input from the one a
 // checkpoint was written with (a change detector, not a defence against tampering).
 std::string file_hash(const fs::path& file) {
@@ -644,6 +660,7 @@ nlohmann::json run_scene(const RunRequest& request) {
     }
   }
   fs::create_directories(out);
+  remove_leftovers(out);
   if (!request.resume) {
     // Keep the scene beside its results so that a run can be resumed and reproduced.
     const std::string text = read_text(request.scene_file);

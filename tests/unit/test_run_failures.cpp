@@ -189,6 +189,12 @@ output: {every: 0.01}
   }
   std::ofstream(meta) << meta_text;
 
+  // Leftovers of a run that died while writing are cleaned on the next start.
+  fs::create_directories(dir / "out" / "checkpoint.tmp");
+  std::ofstream(dir / "out" / "checkpoint.tmp" / "x.bin") << "partial";
+  std::ofstream(dir / "out" / "probes.csv.tmp-99999") << "partial";
+  fs::create_directories(dir / "out" / "checkpoint.old");
+
   r = {};
   r.resume = dir / "out";
   r.out = dir / "out";
@@ -199,6 +205,9 @@ output: {every: 0.01}
   EXPECT_EQ(resumed.at("status"), "completed");
   EXPECT_GE(resumed.at("simulated_time").get<double>(), stopped + 0.02);
   EXPECT_GT(resumed.at("steps").get<std::uint64_t>(), report.at("steps").get<std::uint64_t>());
+  EXPECT_FALSE(fs::exists(dir / "out" / "checkpoint.tmp"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "probes.csv.tmp-99999"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "checkpoint.old"));
   // Numbers after a resume (issue #27 item 10): the whole run's wall time includes the second
   // before the interruption (it was not restored, so the rate came out up to 100 times too high),
   // and the resumed segment reports its own steps and rate.
