@@ -121,11 +121,14 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     // Messages that already start with FILE:LINE:COL: error: stay at the start of the line, where
     // editors and log matchers look for them.
+    // Such a message is a scene error found past the reader (a material that the physics refuses,
+    // a body whose inertia is not finite): exit 2 like the reader's own.
     const std::string what = e.what();
-    if (what.find(": error: ") != std::string::npos && what.find(": error: ") < what.find(' '))
+    if (what.find(": error: ") != std::string::npos && what.find(": error: ") < what.find(' ')) {
       std::fprintf(stderr, "%s\n", what.c_str());
-    else
-      std::fprintf(stderr, "turbid: error: %s\n", what.c_str());
+      return 2;
+    }
+    std::fprintf(stderr, "turbid: error: %s\n", what.c_str());
     return 1;
   }
 }
