@@ -51,7 +51,8 @@ double evaluate(const Scene& scene, const ProbeSpec& probe, const sph::ParticleS
           den += w;
         }
       });
-      return den > 0 ? num / den : std::nan("");
+      // No reading where too little fluid is near the point (a dry sensor, one stray particle).
+      return den > 0 && den >= probe.min_kernel_sum ? num / den : std::nan("");
     }
     case ProbeSpec::Type::max_speed: {
       double v2 = 0;

@@ -1439,7 +1439,7 @@ void Reader::read_probes(const Value& v, fsi::Scene& scene) const {
                                           "fluid_particles", "surface_elevation", "material_mass"};
   std::map<std::string, int> first_line;
   for (const Value& item : list(v)) {
-    MapView m(*this, item, {"name", "type", "material", "axis", "point", "at"});
+    MapView m(*this, item, {"name", "type", "material", "axis", "point", "at", "min_kernel_sum"});
     fsi::ProbeSpec probe;
     probe.where = where(item.mark);
     const Value nv = m.need("name");
@@ -1460,13 +1460,13 @@ void Reader::read_probes(const Value& v, fsi::Scene& scene) const {
     probe.type = static_cast<fsi::ProbeSpec::Type>(t);
     std::vector<std::string> uses;
     if (probe.type == fsi::ProbeSpec::Type::front_position) uses = {"material", "axis"};
-    if (probe.type == fsi::ProbeSpec::Type::pressure) uses = {"point"};
+    if (probe.type == fsi::ProbeSpec::Type::pressure) uses = {"point", "min_kernel_sum"};
     if (probe.type == fsi::ProbeSpec::Type::surface_elevation) uses = {"material", "at"};
     if (probe.type == fsi::ProbeSpec::Type::material_mass) {
       uses = {"material"};
       m.need("material");
     }
-    for (const char* key : {"material", "axis", "point", "at"})
+    for (const char* key : {"material", "axis", "point", "at", "min_kernel_sum"})
       if (m.has(key) && std::find(uses.begin(), uses.end(), key) == uses.end())
         fail(m.key_mark(key), "'" + std::string(key) + "' does not apply to a '" + types[t] + "' probe");
 
@@ -1483,6 +1483,12 @@ void Reader::read_probes(const Value& v, fsi::Scene& scene) const {
       probe.axis = static_cast<int>(choice(*av, axes, z_in_2d ? "a 2D scene has no z axis" : ""));
     }
     if (probe.type == fsi::ProbeSpec::Type::pressure) probe.point = point(m.need("point"), dims, "m");
+    if (auto kv = m.get("min_kernel_sum")) {
+      probe.min_kernel_sum = number(*kv, non_negative());
+      if (probe.min_kernel_sum >= 1)
+        fail(kv->mark, "'min_kernel_sum' is a fraction of the full kernel sum (1 inside the fluid), below 1; got " +
+                           fmt(probe.min_kernel_sum));
+    }
     if (probe.type == fsi::ProbeSpec::Type::surface_elevation) {
       // The elevation is measured along the last axis (y in 2D, z in 3D), the one the default
       // gravity points down; `at` gives the station's other coordinates. A scene whose gravity

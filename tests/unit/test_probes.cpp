@@ -96,3 +96,35 @@ TEST(SurfaceElevationProbe, ThreeDimensionalStationIsAnXyPoint) {
 }
 
 }  // namespace
+
+// Issue #27 item 11: the pressure probe is a Shepard average, so one stray particle used to give a
+// reading. Below `min_kernel_sum` (default 0.2; Wendland C2 with h = 2 dx: 1 inside the fluid,
+// about 0.5 at a flat free surface, 7 / (16 pi) = 0.139 for one particle sitting on the point) it
+// writes nan; a stated 0 reads any fluid at all.
+TEST(PressureProbe, OneStrayParticleGivesNoReadingUnlessAsked) {
+  fsi::Scene s = layered_2d();
+  fsi::FluidBlock lone;
+  lone.material = "water";
+  lone.box = {{1.5, 0.8, 0}, {1.51, 0.81, 0}};  // one particle at (1.505, 0.805), beside the block
+  s.fluids.push_back(lone);
+  auto pressure = [](const char* name, double x, double y, double min_sum) {
+    fsi::ProbeSpec p;
+    p.name = name;
+    p.type = fsi::ProbeSpec::Type::pressure;
+    p.point = {x, y, 0};
+    if (min_sum >= 0) p.min_kernel_sum = min_sum;
+    return p;
+  };
+  s.probes = {pressure("deep", 0.5, 0.05, -1), pressure("surface", 0.5, 0.3, -1), pressure("stray", 1.505, 0.805, -1),
+              pressure("stray_any", 1.505, 0.805, 0.0)};
+  fsi::Simulation sim(s, {"cpu", 1});
+  sim.start();  // the first force pass sets the pressures of the hydrostatic start
+  const std::vector<double> v = sim.probe_values();
+  ASSERT_EQ(v.size(), 4u);
+  // Hydrostatic start: 0.2 m of water over 0.05 m of mud, p = 1000 g 0.2 + 1800 g 0.05 = 2845 Pa;
+  // the Shepard average over 2h = 0.04 m around the point is linear there, so within 1%.
+  EXPECT_NEAR(v[0], 2845.0, 28.0) << "inside the fluid";
+  EXPECT_FALSE(std::isnan(v[1])) << "on the free surface (kernel sum about 0.5)";
+  EXPECT_TRUE(std::isnan(v[2])) << "one stray particle: " << v[2];
+  EXPECT_FALSE(std::isnan(v[3])) << "min_kernel_sum 0 reads even one particle";
+}
