@@ -19,6 +19,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -56,6 +57,44 @@ void launch(const char* name, std::uint32_t n, const F& f) {
   if (n == 0) return;
   run_pass<<<blocks_for(n), kBlock>>>(f, n);
   TURBID_CUDA_CHECK_LAUNCH(name);
+}
+
+// The same kernel with a register bound: at least MinBlocks blocks of kBlock threads per
+// multiprocessor (3: <= 80 registers a thread, 4: <= 64). The 3D pair passes need 84-108 registers
+// unbounded, which leaves 2 blocks (25% occupancy) on sm_90 for loops that wait on loads.
+template <class F, int MinBlocks>
+__global__ void __launch_bounds__(kBlock, MinBlocks) run_pass_bounded(F f, std::uint32_t n) {
+  const std::size_t i = std::size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (i < n) f(std::uint32_t(i));
+}
+
+// Blocks per multiprocessor the 3D pair passes are compiled for: 4 (<= 64 registers) unless
+// TURBID_CUDA_MIN_BLOCKS says 3 or 0 (unbounded). Measured on an H200 (docs/performance.md, the 3D
+// dam break at 4 M particles): 0.88, 1.15 and 1.25 x 10^8 particle-steps/s for 0, 3 and 4.
+int pair_min_blocks() {
+  static const int v = [] {
+    const char* e = std::getenv("TURBID_CUDA_MIN_BLOCKS");
+    if (e == nullptr || *e == '\0') return 4;
+    const int b = std::atoi(e);
+    return b == 3 || b == 4 ? b : 0;
+  }();
+  return v;
+}
+
+// Launches a pair pass (a neighbour loop per particle): in 3D with the register bound above.
+template <int D, class F>
+void launch_pairs(const char* name, std::uint32_t n, const F& f) {
+  if constexpr (D == 3) {
+    if (n == 0) return;
+    switch (pair_min_blocks()) {
+      case 3: run_pass_bounded<F, 3><<<blocks_for(n), kBlock>>>(f, n); break;
+      case 4: run_pass_bounded<F, 4><<<blocks_for(n), kBlock>>>(f, n); break;
+      default: run_pass<<<blocks_for(n), kBlock>>>(f, n); break;
+    }
+    TURBID_CUDA_CHECK_LAUNCH(name);
+  } else {
+    launch(name, n, f);
+  }
 }
 
 // dst[i] = src[order[i]] for elements of `per` words of type T (generic over the field's size).
@@ -111,6 +150,23 @@ struct CellStartPass {
     }
     cell_start[c] = lo;
   }
+};
+
+// 1 for a fluid particle, 0 otherwise, and 0 past the last particle (the scan's total).
+struct FluidFlagPass {
+  const std::uint8_t* kind;
+  std::uint32_t n;
+  std::uint32_t* flag;
+  __device__ void operator()(std::uint32_t i) const { flag[i] = i < n && kind[i] == std::uint8_t(Kind::fluid) ? 1u : 0u; }
+};
+
+// fluid_before[c] = fluid particles in cells [0, c): the scan of the flags at the cell's first
+// particle (GridView::fluid_before, as the CPU's counting sort builds it).
+struct FluidBeforePass {
+  const std::uint32_t* cell_start;
+  const std::uint32_t* fluid_scan;
+  std::uint32_t* fluid_before;
+  __device__ void operator()(std::uint32_t c) const { fluid_before[c] = fluid_scan[cell_start[c]]; }
 };
 
 struct SpeedPair {
@@ -222,6 +278,8 @@ class CudaBackend final : public Backend {
     while (key_bits_ < 32 && (std::uint64_t(1) << key_bits_) <= cell_count_) ++key_bits_;
     cell_start_.allocate((cell_count_ + 1) * sizeof(std::uint32_t));
     TURBID_CUDA_CHECK(cudaMemset(cell_start_.get(), 0, cell_start_.bytes()));
+    fluid_before_.allocate((cell_count_ + 1) * sizeof(std::uint32_t));
+    TURBID_CUDA_CHECK(cudaMemset(fluid_before_.get(), 0, fluid_before_.bytes()));
     allocate_fields();
     upload();
   }
@@ -368,7 +426,10 @@ class CudaBackend final : public Backend {
       fields_[std::size_t(f)].allocate(capacity_ * fb);
     }
     scratch_.allocate(capacity_ * max_bytes);
-    for (DeviceBuffer* b : {&keys_in_, &keys_out_, &values_in_, &values_out_}) b->allocate(capacity_ * sizeof(std::uint32_t));
+    // One more than the capacity: the fluid count scan after the sort (fluid_before) reuses keys_in_
+    // and values_in_ for n + 1 entries.
+    for (DeviceBuffer* b : {&keys_in_, &keys_out_, &values_in_, &values_out_})
+      b->allocate((capacity_ + 1) * sizeof(std::uint32_t));
     reduce_in_.allocate(capacity_ * 8);  // per-particle SpeedPair, u32 or u64
     result_.ensure(16);
   }
@@ -430,7 +491,7 @@ class CudaBackend final : public Backend {
 
   template <int D>
   GridView<D> grid() const {
-    return layout_.view<D>(cell_start_.as<std::uint32_t>(), nullptr);
+    return layout_.view<D>(cell_start_.as<std::uint32_t>(), fluid_before_.as<std::uint32_t>());
   }
 
   // new[i] = old[order[i]] for one field, by its size in bytes per particle.
@@ -476,6 +537,14 @@ class CudaBackend final : public Backend {
     std::uint32_t kept = 0;
     TURBID_CUDA_CHECK(cudaMemcpy(&kept, cell_start_.as<std::uint32_t>() + cell_count_, sizeof kept, cudaMemcpyDeviceToHost));
     n_ = kept;
+    // fluid_before, so that wall particles with no fluid in their 3^d cells skip the search (the
+    // CPU's shortcut, same results): flags of the kept particles (and a 0 after them), scanned.
+    const std::uint8_t* kind = fields_[std::size_t(ids_.kind)].as<std::uint8_t>();
+    launch("FluidFlagPass", kept + 1, FluidFlagPass{kind, kept, values_in});
+    TURBID_CUB_CALL("cub::DeviceScan::ExclusiveSum(fluid flags)",
+                    cub::DeviceScan::ExclusiveSum(cub_temp, cub_temp_bytes, values_in, keys_in, kept + 1));
+    launch("FluidBeforePass", std::uint32_t(cell_count_ + 1),
+           FluidBeforePass{cell_start_.as<std::uint32_t>(), keys_in, fluid_before_.as<std::uint32_t>()});
     // Keep the host's count in step (shrinking only moves the size); the data follow at sync_to_host().
     if (store_->size() > kept) store_->resize(kept);
     return n - kept;
@@ -489,10 +558,10 @@ class CudaBackend final : public Backend {
       using K = typename decltype(kernel_tag)::type;
       constexpr bool U = decltype(uniform_tag)::value;
       if (params_.diffusion == Diffusion::antuono)
-        launch("DensityGradientPass", P.count, DensityGradientPass<D, K, U>{P, G, params_, NeighbourList{}});
+        launch_pairs<D>("DensityGradientPass", P.count, DensityGradientPass<D, K, U>{P, G, params_, NeighbourList{}});
       dispatch_diffusion(params_.diffusion, [&](auto diff_tag) {
         constexpr Diffusion Df = decltype(diff_tag)::value;
-        launch("ContinuityPass", P.count, ContinuityPass<D, K, Df, U>{P, G, params_, NeighbourList{}});
+        launch_pairs<D>("ContinuityPass", P.count, ContinuityPass<D, K, Df, U>{P, G, params_, NeighbourList{}});
       });
     });
   }
@@ -505,11 +574,11 @@ class CudaBackend final : public Backend {
       using K = typename decltype(kernel_tag)::type;
       constexpr bool U = decltype(uniform_tag)::value;
       if (params_.boundary == Boundary::mdbc || params_.wall_no_slip)
-        launch("MdbcPass", P.count, MdbcPass<D, K, U>{P, G, params_, params_.wall_no_slip, params_.boundary == Boundary::mdbc});
+        launch_pairs<D>("MdbcPass", P.count, MdbcPass<D, K, U>{P, G, params_, params_.wall_no_slip, params_.boundary == Boundary::mdbc});
       if (params_.zone_count > 0) launch("BufferPass", P.count, BufferPass<D, K, U>{P, G, params_});
       if (params_.rheology) launch("RheologyPass", P.count, RheologyPass<D, K, U>{P, G, params_});
       launch("PressurePass", P.count, PressurePass<D>{P, params_});
-      launch("MomentumPass", P.count, MomentumPass<D, K, U>{P, G, params_, NeighbourList{}});
+      launch_pairs<D>("MomentumPass", P.count, MomentumPass<D, K, U>{P, G, params_, NeighbourList{}});
       if (params_.body_count > 0) launch("StructureForcePass", P.count, StructureForcePass<D, K, U>{P, G, params_});
     });
   }
@@ -681,6 +750,7 @@ class CudaBackend final : public Backend {
   std::vector<DeviceBuffer> fields_;  // indexed by FieldId
   DeviceBuffer scratch_;              // gather target, capacity x widest field
   DeviceBuffer cell_start_, keys_in_, keys_out_, values_in_, values_out_;
+  DeviceBuffer fluid_before_;  // cell_count + 1: fluid particles in the cells before each cell
   DeviceBuffer reduce_in_, result_, temp_;
   DeviceBuffer split_slots_, split_rule_, split_first_, split_tally_;  // splitting only, from the first split
   DeviceBuffer relax_zone_, relax_shift_, relax_moment_;  // relaxation after a split, from the first one
