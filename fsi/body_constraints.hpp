@@ -31,6 +31,7 @@ struct BodyConstraint {
   double stiffness = 0;    // k [N/m]
   double damping = 0;      // c [N s/m]
   double rest_length = 0;  // spring: L0 [m]
+  int scene_index = -1;    // its item in the scene's `constraints` list (messages)
 };
 
 // Adds the constraint's wrenches to `out` (one per structure).

@@ -268,7 +268,7 @@ void BodyContacts::evaluate(const std::vector<std::optional<RigidBody>>& bodies,
 }
 
 double BodyContacts::max_substep(const std::vector<std::optional<RigidBody>>& bodies, const std::vector<Wrench>& loads,
-                                 double gravity) const {
+                                 double gravity, std::size_t* limiting) const {
   const std::size_t n = shapes_.size();
   double h = kInfinity;
   std::vector<double> m_eff(n, 0.0), speed(n, 0.0), load(n, 0.0);
@@ -290,20 +290,27 @@ double BodyContacts::max_substep(const std::vector<std::optional<RigidBody>>& bo
     const double floor = std::sqrt(2.0 * force / body_mass * static_overlap);
     return contact_time_step(law, std::max({approach, floor, 1e-6}), 50);
   };
+  const auto take = [&](double candidate, std::size_t k) {
+    if (candidate < h) {
+      h = candidate;
+      if (limiting) *limiting = k;
+    }
+  };
   for (std::size_t k = 0; k < n; ++k) {
     if (m_eff[k] == 0) continue;
     const double per_sphere_mass = m_eff[k];
     const double body_mass = bodies[k]->mass() / double(std::max(1, shapes_[k].face_count));
     if (!world_.faces.empty() || !world_.boxes.empty())
-      h = std::min(h, step(wall_law_[k].law, per_sphere_mass, speed[k], load[k], body_mass));
+      take(step(wall_law_[k].law, per_sphere_mass, speed[k], load[k], body_mass), k);
     for (std::size_t j = 0; j < world_.fixed.size(); ++j)
       if (fixed_law_[k][j].valid)
-        h = std::min(h, step(fixed_law_[k][j].law, per_sphere_mass, speed[k] + obstacle_speed_[j], load[k], body_mass));
+        take(step(fixed_law_[k][j].law, per_sphere_mass, speed[k] + obstacle_speed_[j], load[k], body_mass), k);
     for (std::size_t l = k + 1; l < n; ++l) {
       if (m_eff[l] == 0 || !body_law_[k][l].valid) continue;
       const double reduced = 1.0 / (1.0 / m_eff[k] + 1.0 / m_eff[l]);
-      h = std::min(h, step(body_law_[k][l].law, reduced, speed[k] + speed[l], std::max(load[k], load[l]),
-                           std::min(body_mass, bodies[l]->mass() / double(std::max(1, shapes_[l].face_count)))));
+      take(step(body_law_[k][l].law, reduced, speed[k] + speed[l], std::max(load[k], load[l]),
+                std::min(body_mass, bodies[l]->mass() / double(std::max(1, shapes_[l].face_count)))),
+           k);
     }
   }
   return h;

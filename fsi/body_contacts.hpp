@@ -127,8 +127,9 @@ class BodyContacts {
   // The largest stable body substep [s]: t_c / 50 of the stiffest contact each body may meet (see
   // docs/choices.md), at the larger of the bodies' present approach speed and the speed a body
   // gains falling through its static overlap under `loads` (the slow load: fluid + gravity).
+  // `limiting` (optional) gets the structure whose contact sets it.
   double max_substep(const std::vector<std::optional<RigidBody>>& bodies, const std::vector<Wrench>& loads,
-                     double gravity) const;
+                     double gravity, std::size_t* limiting = nullptr) const;
 
   // Checkpoints: the tangential springs of the contacts open now.
   const std::map<ContactKey, TangentialSpring>& springs() const { return springs_; }

@@ -143,18 +143,34 @@ void BodyCoupling::after_drift(sph::Backend& backend, double dt) {
   // The substep: the smallest of the constraints' and contacts' limits (body_constraints.hpp,
   // body_contacts.hpp), at the state after the slow half-kick.
   double h = dt;
-  for (const auto& c : constraints_) h = std::min(h, constraint_substep(c, bodies_));
+  // Which constraint (its scene item) or contact (its structure) sets h, for the message below.
+  auto source = SubstepLimitError::Source::constraint;
+  int limiting = -1;
+  for (const auto& c : constraints_) {
+    const double hc = constraint_substep(c, bodies_);
+    if (hc < h) {
+      h = hc;
+      source = SubstepLimitError::Source::constraint;
+      limiting = c.scene_index;
+    }
+  }
   if (contacts_) {
     std::vector<Wrench> slow(bodies_.size());
     for (std::size_t k = 0; k < bodies_.size(); ++k) slow[k] = total_load(k);
-    h = std::min(h, contacts_->max_substep(bodies_, slow, gravity_.norm()));
+    std::size_t structure = 0;
+    const double hc = contacts_->max_substep(bodies_, slow, gravity_.norm(), &structure);
+    if (hc < h) {
+      h = hc;
+      source = SubstepLimitError::Source::contact;
+      limiting = int(structure);
+    }
   }
-  constexpr double kMaxSubsteps = 100000;
   const double wanted = std::ceil(dt / h);
   if (!(wanted <= kMaxSubsteps))
-    throw std::runtime_error("the body contacts or constraints need " + std::to_string(wanted) +
-                             " substeps in a fluid step of " + std::to_string(dt) +
-                             " s; lower the contacts' youngs_modulus or the constraints' stiffness");
+    throw SubstepLimitError("the body contacts or constraints need " + std::to_string(wanted) +
+                                " substeps in a fluid step of " + std::to_string(dt) +
+                                " s; lower the contacts' youngs_modulus or the constraints' stiffness",
+                            source, limiting, h, wanted, dt);
   const int n = std::max(1, int(wanted));
   const double sub = dt / n;
   std::vector<Wrench> contact, impulse(bodies_.size());

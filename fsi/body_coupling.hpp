@@ -35,6 +35,8 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -47,10 +49,26 @@
 
 namespace turbid::fsi {
 
+// A constraint or a contact that needs more body substeps in one fluid step than the coupling
+// allows (BodyCoupling::kMaxSubsteps). Simulation::step turns it into a message that names the
+// scene's constraint or structure, its key and its value.
+struct SubstepLimitError : std::runtime_error {
+  enum class Source { constraint, contact };
+  SubstepLimitError(const std::string& what, Source s, int i, double sub, double n, double fluid_dt)
+      : std::runtime_error(what), source(s), index(i), substep(sub), wanted(n), dt(fluid_dt) {}
+  Source source;
+  int index;       // constraint: its item in the scene's `constraints`; contact: the structure
+  double substep;  // the largest stable substep it allows [s]
+  double wanted;   // the substeps it needs in this fluid step
+  double dt;       // the fluid step [s]
+};
+
 class BulletWorld;
 
 class BodyCoupling final : public sph::StepCoupling {
  public:
+  // At most this many body substeps in one fluid step (a constraint or contact past it is refused).
+  static constexpr double kMaxSubsteps = 100000;
   // One entry per structure in scene order: a body for a free structure, none for a fixed one.
   // gravity [m/s^2].
   BodyCoupling(std::vector<std::optional<RigidBody>> bodies, const Eigen::Vector3d& gravity);

@@ -179,6 +179,7 @@ std::vector<BodyConstraint> body_constraints(const Scene& scene, const std::vect
     // ties a free body.
     if (bullet(cs.a.structure) || bullet(cs.b.structure)) continue;
     BodyConstraint c;
+    c.scene_index = int(&cs - scene.constraints.data());
     c.structure_a = cs.a.structure;
     c.structure_b = cs.b.structure;
     double inverse_mass = 0;

@@ -5,6 +5,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -728,7 +729,19 @@ sph::SplitParams split_params(const Scene& scene) {
 
 std::size_t particle_capacity(const Scene& scene, std::size_t initial) {
   if (scene.transitions.empty()) return initial;
-  if (scene.capacity.max_particles > 0) return std::max(scene.capacity.max_particles, initial);
+  if (scene.capacity.max_particles > 0) {
+    // Fewer than the start holds would refuse every split (it was once raised silently).
+    if (scene.capacity.max_particles < initial) {
+      const SourceLocation& w = scene.capacity.where;
+      std::ostringstream os;
+      os << w.file << ":" << w.line << ":" << w.column << ": error: capacity: max_particles = "
+         << scene.capacity.max_particles << " is below the " << initial
+         << " particles the scene starts with (fluid, walls and structures), so no particle could ever split; "
+            "give at least " << initial << " plus room for the daughters, or 'factor' (e.g. 2) instead";
+      throw std::invalid_argument(os.str());
+    }
+    return scene.capacity.max_particles;
+  }
   return std::size_t(std::ceil(scene.capacity.factor * double(initial)));
 }
 
@@ -1063,10 +1076,61 @@ void Simulation::resume(double time, std::uint64_t steps, std::uint64_t removed,
   wall_seconds_ = wall_seconds;  // the whole run's, so its rate counts the steps and time before the resume alike
 }
 
+// A constraint or contact too stiff for the body substeps, told in the scene's terms: which item,
+// which key, its value, and what value would do (the substep scales as sqrt(m / k) for a spring's
+// stiffness, as m / c for its damping, and for a Hertz contact as E^(-2/5) at a given approach
+// speed, E^(-1/3) where the speed of falling through the static overlap sets it: E / ratio^3 does).
+static std::string substep_message(const Scene& scene, const SubstepLimitError& e) {
+  std::ostringstream os;
+  os << std::setprecision(3);
+  const double ratio = e.wanted / BodyCoupling::kMaxSubsteps;  // > 1
+  const auto at = [&](const SourceLocation& w) {
+    os << w.file << ":" << w.line << ":" << w.column << ": error: ";
+  };
+  if (e.source == SubstepLimitError::Source::constraint && e.index >= 0 &&
+      std::size_t(e.index) < scene.constraints.size()) {
+    const ConstraintSpec& c = scene.constraints[std::size_t(e.index)];
+    at(c.where);
+    os << "constraint '" << c.name << "' needs body substeps of " << e.substep << " s, " << e.wanted
+       << " of them in the fluid step of " << e.dt << " s (at most " << BodyCoupling::kMaxSubsteps << "): ";
+    if (c.type == ConstraintSpec::Type::hinge)
+      os << "its pivot stiffness follows from the bodies' masses and the spacing; give the bodies more mass or "
+            "moment of inertia, or use motion: bullet";
+    else {
+      os << "lower";
+      if (c.stiffness > 0)
+        os << " its 'stiffness' (" << c.stiffness << " N/m) below about " << c.stiffness / (ratio * ratio) << " N/m";
+      if (c.stiffness > 0 && c.damping > 0) os << " or";
+      if (c.damping > 0)
+        os << " its 'damping' (" << c.damping << " N s/m) below about " << c.damping / ratio << " N s/m";
+      if (c.stiffness > 0 && c.damping > 0) os << ", whichever sets the substep";
+    }
+  } else if (e.source == SubstepLimitError::Source::contact && e.index >= 0 &&
+             std::size_t(e.index) < scene.structures.size()) {
+    const StructureSpec& st = scene.structures[std::size_t(e.index)];
+    at(st.where);
+    os << "the contacts of structure '" << st.name << "' need body substeps of " << e.substep << " s, " << e.wanted
+       << " of them in the fluid step of " << e.dt << " s (at most " << BodyCoupling::kMaxSubsteps << "): lower ";
+    if (st.contact.given && st.contact.youngs_modulus > 0)
+      os << "its 'contact: youngs_modulus' (" << st.contact.youngs_modulus << " Pa) below about "
+         << st.contact.youngs_modulus / std::pow(ratio, 3.0) << " Pa";
+    else
+      os << "the youngs_modulus of the contacts it meets (its own 'contact' and that of the walls or structures "
+            "it touches)";
+  } else {
+    return e.what();
+  }
+  return os.str();
+}
+
 void Simulation::step() {
   const double dt = solver_->next_time_step();
   particle_steps_ += store_.size();
-  solver_->step(dt);
+  try {
+    solver_->step(dt);
+  } catch (const SubstepLimitError& e) {
+    throw std::runtime_error(substep_message(scene_, e));
+  }
 }
 
 std::vector<sph::BodyLoad> Simulation::structure_loads() {

@@ -29,6 +29,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <numbers>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -119,6 +120,42 @@ constraints:
   EXPECT_LT(angle, 1e-9);
 }
 
+// A spring too stiff for the body substeps (issue #27 item 2): the run stops with a message that
+// names the constraint's scene line, the key and a value that would do; that value, halved, runs.
+TEST(BodyConstraints, TooStiffASpringIsNamedWithAStiffnessThatWouldDo) {
+  const auto yaml = [](const std::string& k) {
+    return head("stiff", "[0, -9.81]", 0.01) + "walls:\n" + kFarTank + R"(structures:
+  - {name: block, box: {size: [0.1, 0.1]}, position: [0.5, 1.0], motion: free, density: 500}
+constraints:
+  - {type: spring, name: hang, a: {structure: block, point: [0.5, 1.0]}, b: {anchor: [0.5, 1.3]}, stiffness: )" +
+           k + "}\n";
+  };
+  fsi::Simulation sim(scene_of(yaml("1e20")), cpu());
+  sim.start();
+  std::string message;
+  try {
+    sim.step();
+  } catch (const std::exception& e) {
+    message = e.what();
+  }
+  std::printf("[ measured ] %s\n", message.c_str());
+  ASSERT_NE(message.find(": error: constraint 'hang' needs body substeps"), std::string::npos) << message;
+  EXPECT_NE(message.find("lower its 'stiffness' (1e+20 N/m)"), std::string::npos) << message;
+  // The scene's line of the constraint: the one after 'constraints:'.
+  const std::string text = yaml("1e20");
+  const int line = 1 + int(std::count(text.begin(), text.begin() + long(text.find("  - {type: spring")), '\n'));
+  EXPECT_NE(message.find(":" + std::to_string(line) + ":"), std::string::npos) << message << " (line " << line << ")";
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(message, m, std::regex("below about ([0-9.e+]+) N/m"))) << message;
+  const double suggested = std::stod(m[1].str());
+  ASSERT_LT(suggested, 1e20);
+  // The spring's substep scales as sqrt(m / k): half the suggested stiffness fits the limit.
+  fsi::Simulation ok(scene_of(yaml(std::to_string(0.5 * suggested))), cpu());
+  ok.start();
+  EXPECT_NO_THROW(ok.step());
+  EXPECT_LE(ok.bodies()->last_substeps(), int(fsi::BodyCoupling::kMaxSubsteps));
+}
+
 TEST(BodyConstraints, SpringBetweenTwoBodiesConservesMomentum) {
   const std::string yaml = head("pair", "[0, 0]", 0.2) + "walls:\n" + kFarTank + R"(structures:
   - {name: left, box: {size: [0.1, 0.1]}, position: [0.5, 1.0], rotation: 10, motion: free, density: 500}
@@ -146,6 +183,37 @@ constraints:
   ASSERT_GT(scale, 1e-3) << "the stretched spring should set the bodies moving";
   EXPECT_LE(worst_p, 1e-12 * scale);
   EXPECT_LE(worst_l, 1e-12 * scale);
+}
+
+// A contact too stiff for the body substeps (issue #27 item 2): the message names the structure's
+// line and its youngs_modulus with a value that would do; that value, halved, runs.
+TEST(BodyContacts, TooStiffAContactIsNamedWithAModulusThatWouldDo) {
+  const auto yaml = [](const std::string& e) {
+    return head("hard", "[0, -9.81]", 0.01) + "walls:\n  - box: {min: [0, 0], max: [0.6, 0.6]}\n" + kFarTank +
+           "structures:\n  - {name: ball, sphere: {radius: 0.05}, position: [0.3, 0.25], motion: free, density: "
+           "1000,\n     contact: {youngs_modulus: " +
+           e + ", poisson_ratio: 0.3, restitution: 0.5, friction: 0.3}}\n";
+  };
+  fsi::Simulation sim(scene_of(yaml("1e40")), cpu());
+  sim.start();
+  std::string message;
+  try {
+    sim.step();
+  } catch (const std::exception& e) {
+    message = e.what();
+  }
+  std::printf("[ measured ] %s\n", message.c_str());
+  ASSERT_NE(message.find(": error: the contacts of structure 'ball' need body substeps"), std::string::npos) << message;
+  const std::string text = yaml("1e40");
+  const int line = 1 + int(std::count(text.begin(), text.begin() + long(text.find("  - {name: ball")), '\n'));
+  EXPECT_NE(message.find(":" + std::to_string(line) + ":"), std::string::npos) << message << " (line " << line << ")";
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(message, m, std::regex("'contact: youngs_modulus' \\(1e\\+40 Pa\\) below about ([0-9.e+]+) Pa")))
+      << message;
+  const double suggested = std::stod(m[1].str());
+  fsi::Simulation ok(scene_of(yaml(std::to_string(0.5 * suggested))), cpu());
+  ok.start();
+  EXPECT_NO_THROW(ok.step());
 }
 
 TEST_P(Contacts, DiscDroppedOnTheFloorReboundsWithTheRestitution) {

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -187,6 +188,32 @@ TEST(TransitionRun, OnFullErrorStopsWithTheDiagnosisAndKeepsTheLastCheckpoint) {
   EXPECT_EQ(resumed.at("error"), report.at("error"));
   EXPECT_EQ(resumed.at("steps"), report.at("steps"));
   EXPECT_EQ(resumed.at("splits_refused"), report.at("splits_refused"));
+  fs::remove_all(dir);
+}
+
+// max_particles below the start (issue #27 item 2) was raised silently, and every split was then
+// refused: it is refused at the scene's capacity line; exactly the start's count is accepted.
+TEST(TransitionRun, MaxParticlesBelowTheStartIsRefusedAtItsLine) {
+  const fs::path dir = scratch("below_start");
+  std::ofstream(dir / "probe.yaml") << collapse_scene("capacity: {factor: 3.0}");
+  const std::size_t n0 = fsi::Simulation(tools::read_scene_file((dir / "probe.yaml").string()), {"cpu", 1}).store().size();
+  const std::string text = collapse_scene("capacity: {max_particles: " + std::to_string(n0 - 1) + "}");
+  std::ofstream(dir / "scene.yaml") << text;
+  const int line = 1 + int(std::count(text.begin(), text.begin() + long(text.find("capacity:")), '\n'));
+  std::string message;
+  try {
+    fsi::Simulation sim(tools::read_scene_file((dir / "scene.yaml").string()), {"cpu", 1});
+  } catch (const std::invalid_argument& e) {
+    message = e.what();
+  }
+  std::printf("[ measured ] %s\n", message.c_str());
+  EXPECT_NE(message.find("scene.yaml:" + std::to_string(line) + ":"), std::string::npos) << message;
+  EXPECT_NE(message.find("max_particles = " + std::to_string(n0 - 1) + " is below the " + std::to_string(n0)),
+            std::string::npos)
+      << message;
+  std::ofstream(dir / "scene.yaml") << collapse_scene("capacity: {max_particles: " + std::to_string(n0) + "}");
+  const fsi::Simulation exact(tools::read_scene_file((dir / "scene.yaml").string()), {"cpu", 1});
+  EXPECT_EQ(exact.store().capacity(), n0);
   fs::remove_all(dir);
 }
 
