@@ -314,6 +314,9 @@ class StructureCarver {
     return distance(p, dx_) < limit;
   }
 
+  // The signed distance of p to structure k, exact where it is below `cutoff`.
+  double distance_to(std::size_t k, const Point& p, double cutoff) const { return solids_[k].signed_distance(p, cutoff); }
+
   // The smallest signed distance of p to the structures, exact where it is below `cutoff`.
   double distance(const Point& p, double cutoff) const {
     double best = std::numeric_limits<double>::infinity();
@@ -385,6 +388,192 @@ double restore_carved_volume(const StructureCarver& carver, const geometry::Aabb
         }
   }
   return restored;
+}
+
+
+// Cells of side dx holding point indices, for "is any point of this set within r of x" (r <= dx).
+class PointHash {
+ public:
+  PointHash(const std::vector<Point>& x, std::size_t first, std::size_t last, double dx, int d)
+      : x_(x), dx_(dx), d_(d) {
+    for (std::size_t i = first; i < last; ++i) cells_[key(cell(x[i]))].push_back(i);
+  }
+  bool any_within(const Point& p, double r) const {
+    const std::array<long, 3> c = cell(p);
+    for (long k = (d_ == 3 ? -1 : 0); k <= (d_ == 3 ? 1 : 0); ++k)
+      for (long j = -1; j <= 1; ++j)
+        for (long i = -1; i <= 1; ++i) {
+          const auto it = cells_.find(key({c[0] + i, c[1] + j, c[2] + k}));
+          if (it == cells_.end()) continue;
+          for (std::size_t q : it->second) {
+            double r2 = 0;
+            for (int a = 0; a < d_; ++a) r2 += (x_[q][a] - p[a]) * (x_[q][a] - p[a]);
+            if (r2 < r * r) return true;
+          }
+        }
+    return false;
+  }
+
+ private:
+  std::array<long, 3> cell(const Point& p) const {
+    return {long(std::floor(p[0] / dx_)), long(std::floor(p[1] / dx_)), d_ == 3 ? long(std::floor(p[2] / dx_)) : 0L};
+  }
+  static long long key(const std::array<long, 3>& c) {
+    return (static_cast<long long>(c[2] & 0x1fffff) << 42) | (static_cast<long long>(c[1] & 0x1fffff) << 21) |
+           static_cast<long long>(c[0] & 0x1fffff);
+  }
+  const std::vector<Point>& x_;
+  double dx_;
+  int d_;
+  std::unordered_map<long long, std::vector<std::size_t>> cells_;
+};
+
+static std::string at_text(const SourceLocation& w, const char* what) {
+  std::ostringstream os;
+  os << w.file << ":" << w.line << ":" << w.column << ": " << what << ": ";
+  return os.str();
+}
+
+static bool moves(const StructureSpec& st) { return st.motion != StructureSpec::Motion::fixed; }
+
+// Layout checks on the particles as built (issue #27 item 2): errors (std::invalid_argument,
+// located) for what cannot be meant, warnings (returned, located) for what may be. x holds the fluid
+// blocks, then the walls, then the structures, in scene order; *_first[k] is where item k starts
+// (one more entry at the end).
+std::vector<std::string> check_layout(const Scene& s, const sph::Domain& domain, const std::vector<Point>& x,
+                                      const std::vector<std::size_t>& block_first,
+                                      const std::vector<std::size_t>& wall_first,
+                                      const std::vector<std::size_t>& structure_first, const StructureCarver& carver) {
+  std::vector<std::string> warnings;
+  const int d = s.dimensions;
+  const double dx = s.particle_spacing;
+  const double touch = 0.5 * dx * (1 - 1e-6);  // closer than this, two particles fill the same space
+  const auto wall_name = [&](std::size_t w) {
+    return "wall " + std::to_string(w + 1) + " of 'walls' (line " + std::to_string(s.walls[w].where.line) + ")";
+  };
+  // 1. A structure reaching out of the stated domain loses the particles there at the start.
+  if (s.domain)
+    for (std::size_t b = 0; b < s.structures.size(); ++b)
+      for (int k = 0; k < d; ++k) {
+        if (s.periodic[std::size_t(k)]) continue;
+        double lo = 1e300, hi = -1e300;
+        for (std::size_t i = structure_first[b]; i < structure_first[b + 1]; ++i) {
+          lo = std::min(lo, x[i][k]);
+          hi = std::max(hi, x[i][k]);
+        }
+        if (lo < domain.min[k] || hi > domain.max[k]) {
+          std::ostringstream os;
+          os << at_text(s.structures[b].where, "error") << "structure '" << s.structures[b].name
+             << "' reaches outside 'domain' along " << "xyz"[k] << " (its particles span " << lo << " to " << hi
+             << " m, the domain " << domain.min[k] << " to " << domain.max[k]
+             << " m); the particles outside would be dropped at the start. Move it or widen the domain";
+          throw std::invalid_argument(os.str());
+        }
+      }
+  // 2. Structures inside each other, or inside a wall: an error when one of them moves (contacts
+  //    and forces would start from an overlap), a warning when both are fixed.
+  for (std::size_t a = 0; a < s.structures.size(); ++a) {
+    for (std::size_t b = 0; b < s.structures.size(); ++b) {
+      if (a == b) continue;
+      std::size_t inside = 0;
+      for (std::size_t i = structure_first[a]; i < structure_first[a + 1]; ++i)
+        if (carver.distance_to(b, x[i], dx) < -touch) ++inside;
+      if (inside == 0 || (b < a && !moves(s.structures[a]) && !moves(s.structures[b]))) continue;
+      const bool error = moves(s.structures[a]) || moves(s.structures[b]);
+      std::ostringstream os;
+      os << at_text(s.structures[a].where, error ? "error" : "warning") << "structure '" << s.structures[a].name
+         << "' overlaps structure '" << s.structures[b].name << "' (line " << s.structures[b].where.line << "): "
+         << inside << " of its particles lie more than dx/2 inside it";
+      if (error) {
+        os << "; a moving structure must start clear of the others";
+        throw std::invalid_argument(os.str());
+      }
+      os << " (both fixed: the fluid sees their union, forces.csv reports each)";
+      warnings.push_back(os.str());
+    }
+    for (std::size_t w = 0; w < s.walls.size(); ++w) {
+      const PointHash wall(x, wall_first[w], wall_first[w + 1], dx, d);
+      std::size_t inside = 0;
+      for (std::size_t i = structure_first[a]; i < structure_first[a + 1]; ++i)
+        if (wall.any_within(x[i], touch)) ++inside;
+      if (inside == 0) continue;
+      const bool error = moves(s.structures[a]);
+      std::ostringstream os;
+      os << at_text(s.structures[a].where, error ? "error" : "warning") << "structure '" << s.structures[a].name
+         << "' overlaps " << wall_name(w) << ": " << inside << " of its particles lie within dx/2 of the wall's";
+      if (error) {
+        os << "; a moving structure must start clear of the walls";
+        throw std::invalid_argument(os.str());
+      }
+      warnings.push_back(os.str());
+    }
+  }
+  // 3. A wall drawn through fluid: wall and fluid particles in the same space.
+  for (std::size_t f = 0; f < s.fluids.size(); ++f) {
+    const PointHash fluid(x, block_first[f], block_first[f + 1], dx, d);
+    for (std::size_t w = 0; w < s.walls.size(); ++w) {
+      std::size_t hits = 0;
+      for (std::size_t i = wall_first[w]; i < wall_first[w + 1]; ++i)
+        if (fluid.any_within(x[i], touch)) ++hits;
+      if (hits == 0) continue;
+      std::ostringstream os;
+      os << at_text(s.walls[w].where, "error") << wall_name(w) << " passes through the fluid of line "
+         << s.fluids[f].where.line << ": " << hits
+         << " of its particles lie within dx/2 of fluid particles. Keep fluid regions on one side of the wall "
+            "(a fluid polygon can follow it)";
+      throw std::invalid_argument(os.str());
+    }
+  }
+  // 4. Fluid with nothing beneath it falls out of the scene: along gravity's axis (when it is not
+  //    periodic), a fluid particle is held if some wall or structure particle lies below it within
+  //    dx sideways. A warning, whole block or part: a falling jet, or particles meant to leave
+  //    through the domain's faces, may be what the user wants.
+  int down = -1;
+  double gmax = 0;
+  for (int k = 0; k < d; ++k)
+    if (std::abs(s.gravity[std::size_t(k)]) > gmax) {
+      gmax = std::abs(s.gravity[std::size_t(k)]);
+      down = k;
+    }
+  if (down >= 0 && !s.periodic[std::size_t(down)]) {
+    const double sign = s.gravity[std::size_t(down)] < 0 ? 1.0 : -1.0;  // height = sign * coordinate
+    // The lowest solid height per column of side dx across gravity.
+    std::unordered_map<long long, double> lowest;
+    auto column = [&](const Point& p, long di, long dj) {
+      long c[2] = {0, 0};
+      int n = 0;
+      for (int k = 0; k < d; ++k)
+        if (k != down) c[n++] = long(std::floor(p[k] / dx)) + (n == 0 ? di : dj);
+      return (static_cast<long long>(c[1] & 0xffffffff) << 32) | static_cast<long long>(c[0] & 0xffffffff);
+    };
+    for (std::size_t i = block_first.back(); i < structure_first.back(); ++i) {
+      const double hgt = sign * x[i][down];
+      auto [it, fresh] = lowest.emplace(column(x[i], 0, 0), hgt);
+      if (!fresh) it->second = std::min(it->second, hgt);
+    }
+    for (std::size_t f = 0; f < s.fluids.size(); ++f) {
+      std::size_t unheld = 0;
+      const std::size_t n = block_first[f + 1] - block_first[f];
+      for (std::size_t i = block_first[f]; i < block_first[f + 1]; ++i) {
+        const double hgt = sign * x[i][down];
+        bool held = false;
+        for (long di = -1; di <= 1 && !held; ++di)
+          for (long dj = (d == 3 ? -1 : 0); dj <= (d == 3 ? 1 : 0) && !held; ++dj) {
+            const auto it = lowest.find(column(x[i], di, dj));
+            held = it != lowest.end() && it->second < hgt;
+          }
+        if (!held) ++unheld;
+      }
+      if (unheld == 0 || n == 0) continue;
+      std::ostringstream os;
+      const bool all = unheld == n;
+      os << at_text(s.fluids[f].where, "warning") << "the fluid of this block has " << (all ? "nothing" : "in part nothing")
+         << " beneath it: " << unheld << " of its " << n
+         << " particles have no wall or structure below them along gravity, so they fall out of the scene";
+      warnings.push_back(os.str());
+    }
+  }
+  return warnings;
 }
 
 }  // namespace
@@ -608,14 +797,13 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
   } else if (options.backend == "auto") {
     std::string why;
     backend = sph::cuda_device_count(&why) > 0 ? sph::make_cuda_backend() : sph::make_cpu_backend(options.threads);
-    // A backend without splitting (or moving bodies) hands the scene to the CPU. Moving bodies on
-    // CUDA (sph/backend/cuda) are built but have not yet run on a GPU (CudaBodies.* in
-    // tests/unit/test_cuda_bodies.cpp wait for a device): until they have, 'auto' keeps such scenes
-    // on the CPU and '--backend cuda' runs them.
+    // A backend without splitting, implicit viscosity or moving bodies hands the scene to the CPU.
+    // Moving bodies on CUDA passed CudaBodies.* (tests/unit/test_cuda_bodies.cpp) on an H200 on
+    // 2026-12-04 (docs/performance.md, "GPU"), so 'auto' runs them there.
     if (!scene_.transitions.empty() && !backend->supports_splitting()) backend = sph::make_cpu_backend(options.threads);
     if (params_.implicit_viscosity && !backend->supports_implicit_viscosity())
       backend = sph::make_cpu_backend(options.threads);
-    if ((free_bodies || prescribed) && (!backend->supports_moving_bodies() || backend->name() == "cuda"))
+    if ((free_bodies || prescribed) && !backend->supports_moving_bodies())
       backend = sph::make_cpu_backend(options.threads);
   } else {
     throw std::invalid_argument("unknown backend '" + options.backend + "' (expected auto, cpu or cuda)");
@@ -843,7 +1031,38 @@ void Simulation::build_particles() {
     return eos.density_at_gauge(layered_pressure(s, params_, xc, block_material));
   };
 
+  // The cells the box walls fill, as built (geometry::lattice_box: whole cells from the min corner,
+  // up to dx/2 off the stated box). A fluid lattice point whose cell lies mostly in them (its centre
+  // less than dx/4 inside a closed face of a tank, or within dx/4 of an obstacle's cells) is left
+  // out: a block stated up to a wall that the lattice ends short of would otherwise sit in the
+  // wall's layers (issue #27 item 8).
+  std::vector<geometry::Aabb> wall_cells;  // per wall: container inner box or solid box, as built
+  for (const auto& w : s.walls) wall_cells.push_back(geometry::lattice_box(to_aabb(w.box), dx, d));
+  auto in_wall_cells = [&](const Point& x) {
+    const double q = 0.25 * dx;
+    for (std::size_t w = 0; w < s.walls.size(); ++w) {
+      const WallSpec& wall = s.walls[w];
+      const geometry::Aabb& c = wall_cells[w];
+      if (wall.kind == WallSpec::Kind::solid_box) {
+        bool inside = true;
+        for (int k = 0; k < d; ++k) inside = inside && x[k] > c.min[k] - q && x[k] < c.max[k] + q;
+        if (inside) return true;
+      } else if (wall.kind == WallSpec::Kind::container) {
+        bool near = true;  // within the tank's cells grown by half a cell
+        for (int k = 0; k < d; ++k) near = near && x[k] >= c.min[k] - 0.5 * dx && x[k] <= c.max[k] + 0.5 * dx;
+        if (!near) continue;
+        for (int k = 0; k < d; ++k)
+          if ((!wall.open[2 * k] && x[k] - c.min[k] < q) || (!wall.open[2 * k + 1] && c.max[k] - x[k] < q)) return true;
+      }
+    }
+    return false;
+  };
+
+  std::vector<std::pair<SourceLocation, std::size_t>> wall_drops;  // per block with points left out
+  std::vector<std::size_t> block_first;  // items of fluid block b: [block_first[b], block_first[b + 1])
   for (const auto& f : s.fluids) {
+    block_first.push_back(items.size());
+    std::size_t left_in_walls = 0;
     const std::uint8_t m = material_of(f.material, f.where);
     const auto& eos = params_.materials[m].eos;
     const HeightRange heights = box_heights(s, f.box);
@@ -869,8 +1088,35 @@ void Simulation::build_particles() {
     // would be (geometry::extrude_across_y), so it meets tank walls and boxes on the same y rows.
     const int v = section_axis(d);
     std::vector<Point> lattice;
+    geometry::Aabb block_cells = to_aabb(f.box);  // the box whose whole cells the block's lattice fills
     if (f.polygon.empty()) {
-      lattice = geometry::fill_box(to_aabb(f.box), dx, d);
+      // A box inside a tank takes the tank's lattice (whole cells from the tank's min corner),
+      // clipped to the tank's cells at its closed faces: its particles then stand exactly dx from
+      // the wall particles, also where the lattice ends the tank up to dx/2 short of the stated box
+      // (a block stated up to x = 3.22 in a tank built to 3.21 once reached into the wall's
+      // layers; issue #27 item 8). Each face moves by at most dx/2; `turbid check` lists both.
+      for (std::size_t w = 0; w < s.walls.size(); ++w) {
+        if (s.walls[w].kind != WallSpec::Kind::container) continue;
+        const geometry::Aabb& c = wall_cells[w];
+        bool centred = true;
+        for (int k = 0; k < d; ++k) {
+          const double mid = 0.5 * (f.box.min[k] + f.box.max[k]);
+          centred = centred && mid > c.min[k] && mid < c.max[k];
+        }
+        if (!centred) continue;
+        for (int k = 0; k < d; ++k) {
+          const double a = c.min[k];
+          long i0 = std::lround((f.box.min[k] - a) / dx), i1 = std::lround((f.box.max[k] - a) / dx);
+          const long n = std::lround((c.max[k] - a) / dx);
+          if (!s.walls[w].open[2 * k]) i0 = std::max(i0, 0L);
+          if (!s.walls[w].open[2 * k + 1]) i1 = std::min(i1, n);
+          if (i1 <= i0) i1 = i0 + 1;  // at least one cell, as fill_box
+          block_cells.min[k] = a + double(i0) * dx;
+          block_cells.max[k] = a + double(i1) * dx;
+        }
+        break;
+      }
+      lattice = geometry::fill_box(block_cells, dx, d);
     } else {
       // (i + 1/2) dx, computed from the integer indices so that a box anchored at the origin
       // produces the very same coordinates.
@@ -891,6 +1137,10 @@ void Simulation::build_particles() {
         carved.push_back(x);
         continue;
       }
+      if (in_wall_cells(x)) {
+        ++left_in_walls;
+        continue;
+      }
       const double depth = std::max(0.0, top - height_of(s, x));
       const double rho = layered ? layered_density(eos, x, false) : eos.hydrostatic_density(g, depth);
       items.push_back({x, rho, m, sph::Kind::fluid, {0, 0, 0}, sph::kNoBody, cell_volume,
@@ -905,7 +1155,7 @@ void Simulation::build_particles() {
       for (std::size_t i = first; i < items.size(); ++i) kept.push_back(items[i].x);
       std::vector<Point> moments(kept.size(), Point{0, 0, 0});
       summary_.fluid_volume_restored +=
-          restore_carved_volume(carver, to_aabb(f.box), dx, d, carved, kept, volumes, moments);
+          restore_carved_volume(carver, block_cells, dx, d, carved, kept, volumes, moments);
       // A particle that took over part of the gap moves to the centroid of all it stands for, and
       // starts at the hydrostatic density there.
       for (std::size_t q = 0; q < kept.size(); ++q) {
@@ -916,11 +1166,59 @@ void Simulation::build_particles() {
                              : eos.hydrostatic_density(g, std::max(0.0, top - height_of(s, it.x)));
       }
     }
+    if (left_in_walls > 0) wall_drops.push_back({f.where, left_in_walls});
   }
   summary_.fluid_particles = items.size();
+  block_first.push_back(items.size());
+  for (std::size_t b = 0; b < s.fluids.size(); ++b) {
+    const FluidBlock& f = s.fluids[b];
+    WorldSummary::Extent e;
+    e.what = "fluid block";
+    e.where = f.where;
+    e.stated = f.box;
+    if (f.polygon.empty()) {
+      e.stated_volume = 1;
+      for (int k = 0; k < d; ++k) e.stated_volume *= f.box.max[k] - f.box.min[k];
+    } else {
+      double area = 0;  // shoelace, in the section plane
+      for (std::size_t i = 0; i < f.polygon.size(); ++i) {
+        const auto& a = f.polygon[i];
+        const auto& c = f.polygon[(i + 1) % f.polygon.size()];
+        area += a[0] * c[1] - c[0] * a[1];
+      }
+      e.stated_volume = 0.5 * std::abs(area) * (d == 3 ? f.span[1] - f.span[0] : 1.0);
+    }
+    e.built = {{1e300, 1e300, 0}, {-1e300, -1e300, 0}};
+    if (d == 3) e.built.min[2] = 1e300, e.built.max[2] = -1e300;
+    for (std::size_t i = block_first[b]; i < block_first[b + 1]; ++i) {
+      e.built_volume += items[i].volume;
+      for (int k = 0; k < d; ++k) {
+        e.built.min[k] = std::min(e.built.min[k], items[i].x[k] - 0.5 * dx);
+        e.built.max[k] = std::max(e.built.max[k], items[i].x[k] + 0.5 * dx);
+      }
+    }
+    summary_.extents.push_back(e);
+  }
+  for (std::size_t w = 0; w < s.walls.size(); ++w) {
+    const WallSpec& wall = s.walls[w];
+    if (wall.kind == WallSpec::Kind::polyline) continue;
+    WorldSummary::Extent e;
+    e.what = wall.kind == WallSpec::Kind::container ? "container" : "solid box";
+    e.where = wall.where;
+    e.stated = wall.box;
+    e.built = {wall_cells[w].min, wall_cells[w].max};
+    e.stated_volume = e.built_volume = 1;
+    for (int k = 0; k < d; ++k) {
+      e.stated_volume *= wall.box.max[k] - wall.box.min[k];
+      e.built_volume *= e.built.max[k] - e.built.min[k];
+    }
+    summary_.extents.push_back(e);
+  }
 
   const auto& wall_eos = params_.materials[params_.wall_material].eos;
+  std::vector<std::size_t> wall_first;  // items of wall w: [wall_first[w], wall_first[w + 1])
   for (const auto& w : s.walls) {
+    wall_first.push_back(items.size());
     const int layers = wall_layers(s, w);
     std::vector<geometry::Point> pts;
     switch (w.kind) {
@@ -946,8 +1244,11 @@ void Simulation::build_particles() {
       items.push_back({x, rho, 0, sph::Kind::wall, ghost, sph::kNoBody, cell_volume, {0, 0, 0}, sph::kNoZone, w.free_slip});
     }
   }
+  wall_first.push_back(items.size());
   summary_.wall_particles = items.size() - summary_.fluid_particles;
+  std::vector<std::size_t> structure_first;  // items of structure b: [structure_first[b], structure_first[b + 1])
   for (std::size_t b = 0; b < bodies.size(); ++b) {
+    structure_first.push_back(items.size());
     const auto& body = bodies[b];
     Point centre{0, 0, 0};
     for (const auto& fb : summary_.free_bodies)
@@ -965,6 +1266,7 @@ void Simulation::build_particles() {
       for (std::size_t k = 0; k < 3; ++k) items.back().offset[k] = x[k] - centre[k];
     }
   }
+  structure_first.push_back(items.size());
   summary_.structure_particles = items.size() - summary_.fluid_particles - summary_.wall_particles;
   const double support = 2.0 * double(params_.smoothing_length);
   for (std::size_t k = 0; k < s.open_boundaries.size(); ++k) {
@@ -1014,6 +1316,21 @@ void Simulation::build_particles() {
       const double margin = std::max(0.1 * (hi[k] - lo[k]), 4.0 * double(params_.smoothing_length));
       summary_.domain.min[k] = lo[k] - margin;
       summary_.domain.max[k] = hi[k] + margin;
+    }
+  }
+
+  {
+    std::vector<Point> xs(items.size());
+    for (std::size_t i = 0; i < items.size(); ++i) xs[i] = items[i].x;
+    summary_.warnings = check_layout(s, summary_.domain, xs, block_first, wall_first, structure_first, carver);
+    for (const auto& [where, n] : wall_drops) {
+      summary_.fluid_removed_by_walls += n;
+      std::ostringstream os;
+      os << where.file << ":" << where.line << ":" << where.column << ": warning: " << n
+         << " lattice points of this fluid block lie in the cells of a wall as built (walls are whole cells from "
+            "their min corner, up to dx/2 off the stated box) and are left out; state the block up to the wall's "
+            "built extent (turbid check lists it) to silence this";
+      summary_.warnings.push_back(os.str());
     }
   }
 

@@ -53,6 +53,19 @@ struct WorldSummary {
   std::vector<double> sound_speed; // per material [m/s]
   std::size_t bytes_per_particle = 0;
   sph::Domain domain;
+  // "file:line:col: warning: ..." for layouts a user may mean but should know about (overlapping
+  // fixed structures, fluid with nothing beneath it); `turbid check` and `run` print them.
+  std::vector<std::string> warnings;
+  // Each fluid block and box wall as stated and as built (issue #27 item 8): the lattice rounds a
+  // box to whole cells from its min corner, so it may end up to dx/2 short or long per axis.
+  struct Extent {
+    std::string what;        // "fluid block" | "container" | "solid box"
+    SourceLocation where;
+    Box stated, built;       // built: the cells of its particles (a container: its inner box)
+    double stated_volume = 0, built_volume = 0;  // [m^d]; fluid: particles' volume, walls: inner/solid
+  };
+  std::vector<Extent> extents;
+  std::size_t fluid_removed_by_walls = 0;  // fluid lattice points whose cells lie mostly in a wall's cells
 };
 
 class Simulation;

@@ -14,6 +14,12 @@ int cells_along(double length, double dx) {
 
 }  // namespace
 
+Aabb lattice_box(const Aabb& box, double dx, int dims) {
+  Aabb out = box;
+  for (int k = 0; k < dims; ++k) out.max[k] = box.min[k] + cells_along(box.max[k] - box.min[k], dx) * dx;
+  return out;
+}
+
 std::vector<Point> fill_box(const Aabb& box, double dx, int dims) {
   if (!(dx > 0)) throw std::invalid_argument("fill_box: spacing must be positive");
   int n[3] = {1, 1, 1};

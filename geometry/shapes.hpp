@@ -13,6 +13,11 @@ struct Aabb {
   Point max{0, 0, 0};
 };
 
+// The box a lattice of whole cells covers: [min, min + n dx] per axis, n = max(1, round(extent / dx))
+// (fill_box's points fill it, container_walls' walls stand outside it). It differs from the stated
+// box by up to dx/2 per axis.
+Aabb lattice_box(const Aabb& box, double dx, int dims);
+
 // Cell-centred lattice points (spacing dx) inside [min, max] in the first `dims` axes.
 std::vector<Point> fill_box(const Aabb& box, double dx, int dims);
 

@@ -546,6 +546,24 @@ std::string describe_scene(const fsi::Scene& scene) {
     os << "  fluid lattice points left out inside structures: " << s.fluid_removed_by_structures
        << " (the part of their cells outside the structures, " << s.fluid_volume_restored << (two_d ? " m^2" : " m^3")
        << ", goes to the nearest fluid particles)\n";
+  if (s.fluid_removed_by_walls > 0)
+    os << "  fluid lattice points left out in the cells of box walls: " << s.fluid_removed_by_walls << "\n";
+  // Every fluid block and box wall as stated and as built (whole cells from the min corner).
+  for (const auto& e : s.extents) {
+    os << "  " << e.what << " (line " << e.where.line << "):";
+    for (int k = 0; k < scene.dimensions; ++k) {
+      os << " " << "xyz"[k] << " " << e.stated.min[k] << " to " << e.stated.max[k];
+      const double tol = 1e-6 * scene.particle_spacing;
+      if (std::abs(e.built.min[k] - e.stated.min[k]) > tol || std::abs(e.built.max[k] - e.stated.max[k]) > tol)
+        os << " (built " << e.built.min[k] << " to " << e.built.max[k] << ")";
+      os << ",";
+    }
+    os << " " << (e.what == "container" ? "inside " : "") << "volume " << e.stated_volume;
+    if (std::abs(e.built_volume - e.stated_volume) > 1e-6 * e.stated_volume)
+      os << " (built " << e.built_volume << ", " << std::showpos << 100 * (e.built_volume / e.stated_volume - 1)
+         << std::noshowpos << "%)";
+    os << (two_d ? " m^2\n" : " m^3\n");
+  }
   const sph::PhysicsParams params = fsi::physics_params(scene);
   for (std::size_t m = 0; m < scene.materials.size(); ++m) {
     const auto& mat = scene.materials[m];
@@ -591,6 +609,7 @@ std::string describe_scene(const fsi::Scene& scene) {
        << (scene.capacity.error_when_full ? "error" : "warn") << ")";
   os << "\n";
   os << "end time         " << scene.end_time << " s, output every " << scene.output.every << " s\n";
+  for (const auto& w : s.warnings) os << w << "\n";
   return os.str();
 }
 
@@ -693,7 +712,8 @@ nlohmann::json run_scene(const RunRequest& request) {
                  on_gpu ? gpu.c_str() : (" with " + std::to_string(sim.threads()) + " threads").c_str(),
                  out.string().c_str());
   }
-
+  // Layout warnings (fsi::WorldSummary::warnings) go to stderr whether or not progress is shown.
+  for (const auto& w : sim.summary().warnings) std::fprintf(stderr, "%s\n", w.c_str());
 
   nlohmann::json report;
   report["scene"] = scene.name;
