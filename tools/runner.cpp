@@ -549,6 +549,9 @@ std::string describe_scene(const fsi::Scene& scene) {
   if (s.fluid_removed_by_walls > 0)
     os << "  fluid lattice points left out in the cells of box walls: " << s.fluid_removed_by_walls << "\n";
   // Every fluid block and box wall as stated and as built (whole cells from the min corner).
+  if (!s.extents.empty())
+    os << "  as stated (built: a block's own particles, after structures and earlier blocks took theirs; a wall's "
+          "whole cells):\n";
   for (const auto& e : s.extents) {
     os << "  " << e.what << " (line " << e.where.line << "):";
     for (int k = 0; k < scene.dimensions; ++k) {
