@@ -784,6 +784,12 @@ nlohmann::json run_scene(const RunRequest& request) {
   } catch (const sph::BlowUp& e) {
     status = "blow-up";
     report["error"] = e.what();
+  } catch (const std::exception& e) {
+    // A failed write (a full disk, an output path taken by a directory), or a run-time refusal such
+    // as a constraint too stiff for the body substeps: the run ends here with run.json saying so
+    // (issue #27 item 6); the checkpoint before it, if any, still resumes.
+    status = "failed";
+    report["error"] = e.what();
   }
   sim.sync_to_host();
   const double mass_end = fluid_mass(sim);
@@ -845,7 +851,12 @@ nlohmann::json run_scene(const RunRequest& request) {
                             {"particles_end", materials_end.particles[m]}, {"mass_start", materials_start.mass[m]},
                             {"mass_end", materials_end.mass[m]}});
   report["materials"] = per_material;
-  write_run_json(out / "run.json", report);
+  try {
+    write_run_json(out / "run.json", report);
+  } catch (const std::exception& e) {
+    // The disk may be full: the caller still says where the outputs are and how to resume.
+    report["run_json_error"] = e.what();
+  }
   return report;
 }
 

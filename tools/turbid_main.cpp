@@ -100,9 +100,18 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "turbid: continue with: turbid run --resume %s\n", dir.c_str());
       return 128 + signo;
     }
+    if (report.contains("run_json_error"))
+      std::fprintf(stderr, "turbid: error: run.json could not be written: %s\n",
+                   report.at("run_json_error").get<std::string>().c_str());
     if (report.at("status") != "completed") {
-      std::fprintf(stderr, "turbid: error: %s\n", report.value("error", std::string("run failed")).c_str());
+      // A located message (a scene item refused during the run) keeps FILE:LINE:COL at the start.
+      const std::string error = report.value("error", std::string("run failed"));
+      const auto at = error.find(": error: ");
+      if (at != std::string::npos && at < error.find(' ')) std::fprintf(stderr, "%s\n", error.c_str());
+      else std::fprintf(stderr, "turbid: error: %s\n", error.c_str());
       std::fprintf(stderr, "turbid: outputs up to the failure are in %s\n", dir.c_str());
+      if (std::filesystem::exists(std::filesystem::path(dir) / "checkpoint" / "checkpoint.json"))
+        std::fprintf(stderr, "turbid: the last checkpoint before it resumes with: turbid run --resume %s\n", dir.c_str());
       return 3;
     }
     std::printf("finished: %llu steps, %.4g s simulated in %.1f s wall, %.3g particle-steps/s, %llu particles removed\n",

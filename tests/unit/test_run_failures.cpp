@@ -68,6 +68,55 @@ output: {every: 0.01, vtk: true}
   fs::remove_all(dir);
 }
 
+// A write that fails mid-run (here the second ParaView frame's path is taken by a directory, as a
+// full disk fails a write) ends the run with run.json saying "failed" and naming the file, the
+// outputs before it kept, and the checkpoint before it resumable (issue #27 item 6).
+TEST(RunFailures, AFailedWriteEndsWithRunJsonAndTheCheckpointBeforeItResumes) {
+  const fs::path dir = scratch("write");
+  fs::create_directories(dir / "out" / "particles_0002.vtp");
+  std::ofstream(dir / "scene.yaml") << R"(name: failed_write
+dimensions: 2
+resolution: {particle_spacing: 0.02}
+time: {end: 0.05}
+materials:
+  water: {density: 1000, sound_speed: 20}
+walls:
+  - box: {min: [0, 0], max: [0.4, 0.3]}
+fluids:
+  - {material: water, box: {min: [0, 0], max: [0.2, 0.2]}}
+output: {every: 0.01, vtk: true, checkpoint_every: 0.005}
+)";
+  turbid::tools::RunRequest r;
+  r.scene_file = dir / "scene.yaml";
+  r.out = dir / "out";
+  r.backend = "cpu";
+  r.progress = false;
+  const auto report = turbid::tools::run_scene(r);
+  ASSERT_EQ(report.at("status"), "failed");
+  const std::string error = report.at("error");
+  std::printf("[ measured ] failed at t = %.4f s: %s\n", report.at("simulated_time").get<double>(), error.c_str());
+  EXPECT_NE(error.find("particles_0002.vtp"), std::string::npos) << error;
+  ASSERT_TRUE(fs::exists(dir / "out" / "run.json"));
+  std::ifstream in(dir / "out" / "run.json");
+  const auto written = nlohmann::json::parse(in);
+  EXPECT_EQ(written.at("status"), "failed");
+  EXPECT_EQ(written.at("error"), error);
+  EXPECT_TRUE(fs::exists(dir / "out" / "particles_0001.vtp"));
+  // Output 2 is due at t = 0.02 s; the checkpoints every 0.005 s before it are on disk and resume.
+  EXPECT_GE(report.at("simulated_time").get<double>(), 0.02);
+  EXPECT_LT(report.at("simulated_time").get<double>(), 0.03);
+  ASSERT_TRUE(fs::exists(dir / "out" / "checkpoint" / "checkpoint.json"));
+  fs::remove_all(dir / "out" / "particles_0002.vtp");
+  turbid::tools::RunRequest again;
+  again.resume = dir / "out";
+  again.backend = "cpu";
+  again.progress = false;
+  const auto resumed = turbid::tools::run_scene(again);
+  EXPECT_EQ(resumed.at("status"), "completed");
+  EXPECT_NEAR(resumed.at("simulated_time").get<double>(), 0.05, 0.002);
+  fs::remove_all(dir);
+}
+
 // Free fall out of the domain: after 0.3 s a body released at rest has fallen g t^2 / 2 = 0.44 m,
 // further than the 0.25 m to the bottom of the domain, so every one of the 25 fluid particles must
 // have been removed and counted, and the run must still complete.
