@@ -616,6 +616,48 @@ std::string describe_scene(const fsi::Scene& scene) {
   return os.str();
 }
 
+// Inputs outside their usual ranges, for a run that blew up within its first steps (issue #27 item
+// 2): there the cause is an input, not the flow, and the blown-up particle alone does not say which.
+std::string early_blow_up_suspects(const fsi::Scene& scene) {
+  std::vector<std::string> out;
+  const auto num = [](double v) {
+    std::ostringstream os;
+    os << std::setprecision(4) << v;
+    return os.str();
+  };
+  const auto& n = scene.numerics;
+  if (n.diffusion != fsi::DiffusionKind::none && n.diffusion_delta > 0.5)
+    out.push_back("numerics: density_diffusion: delta = " + num(n.diffusion_delta) +
+                  " (usually 0.1; the term is explicit, and far above 1 it is unstable at the acoustic time step)");
+  if (n.viscosity == fsi::ViscosityKind::artificial && n.artificial_viscosity > 1.0)
+    out.push_back("numerics: viscosity: alpha = " + num(n.artificial_viscosity) + " (usually 0.01 to 0.1)");
+  if (n.cfl > 0.4) out.push_back("time: cfl = " + num(n.cfl) + " (usually 0.2)");
+  if (n.density_ratio_limit < 0.05)
+    out.push_back("numerics: max_density_variation = " + num(n.density_ratio_limit) +
+                  " (the run stops at that relative density change; a start-up transient can reach a few percent)");
+  const double g = std::hypot(scene.gravity[0], scene.gravity[1], scene.gravity[2]);
+  if (g > 50) out.push_back("gravity: |g| = " + num(g) + " m/s^2 (" + num(g / 9.81) + " times the Earth's)");
+  double lo = 1e300, hi = 0;
+  for (const auto& m : scene.materials) {
+    lo = std::min(lo, m.density);
+    hi = std::max(hi, m.density);
+  }
+  if (scene.materials.size() > 1 && hi > 10 * lo)
+    out.push_back("materials: rest densities from " + num(lo) + " to " + num(hi) +
+                  " kg/m^3 (a ratio above 10 needs a smaller time step than the sound speed alone gives)");
+  for (const auto& st : scene.structures)
+    if (st.motion == fsi::StructureSpec::Motion::free && st.density > 0 && st.density < 0.1 * lo)
+      out.push_back("structure '" + st.name + "' (line " + std::to_string(st.where.line) + "): density " +
+                    num(st.density) + " kg/m^3, under a tenth of the fluid's (a body that light in explicit "
+                                      "coupling is unstable)");
+  if (out.empty())
+    return "no input is outside its usual range; look at the sound speed against the flow's speed and at the "
+           "particle named above";
+  std::string s = "check these inputs, outside their usual ranges: ";
+  for (std::size_t i = 0; i < out.size(); ++i) s += (i ? "; " : "") + out[i];
+  return s;
+}
+
 nlohmann::json run_scene(const RunRequest& request) {
   fsi::Scene scene;
   nlohmann::json ck_state;
@@ -784,6 +826,10 @@ nlohmann::json run_scene(const RunRequest& request) {
   } catch (const sph::BlowUp& e) {
     status = "blow-up";
     report["error"] = e.what();
+    // Within the first steps the cause is an input: name the ones outside their usual ranges.
+    if (sim.steps() <= 20)
+      report["error"] = std::string(e.what()) + "; it happened within the first 20 steps, so " +
+                        early_blow_up_suspects(scene);
   } catch (const std::exception& e) {
     // A failed write (a full disk, an output path taken by a directory), or a run-time refusal such
     // as a constraint too stiff for the body substeps: the run ends here with run.json saying so
