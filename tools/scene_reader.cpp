@@ -121,6 +121,66 @@ constexpr double kMaxParticles = 4294967295.0;
 // cannot fit before allocating it [bytes]; `turbid check` prints the scene's own figure.
 constexpr double kMinBytesPerParticle = 100.0;
 
+// Particles a scene would build, from its stated geometry alone (upper bounds: bounding boxes of
+// fluid blocks and structures, whole wall layers).
+struct ParticleEstimate {
+  double fluid = 0, walls = 0, structures = 0, reserved = 0;
+  double total() const { return fluid + walls + structures + reserved; }
+};
+
+ParticleEstimate estimate_particles(const fsi::Scene& s) {
+  ParticleEstimate e;
+  const int d = s.dimensions;
+  const double dx = s.particle_spacing;
+  const auto cells = [&](double length) { return std::max(1.0, std::floor(length / dx + 0.5)); };
+  const int default_layers = std::max(1, int(std::ceil(2.0 * s.smoothing_ratio - 1e-9)));
+  for (const auto& f : s.fluids) {
+    double n = 1;
+    for (int k = 0; k < d; ++k) n *= cells(f.box.max[k] - f.box.min[k]);
+    e.fluid += n;
+  }
+  for (const auto& w : s.walls) {
+    const double layers = w.layers > 0 ? w.layers : default_layers;
+    if (w.kind == fsi::WallSpec::Kind::polyline) {
+      double length = 0;
+      for (std::size_t i = 0; i + 1 < w.points.size(); ++i)
+        length += std::hypot(w.points[i + 1][0] - w.points[i][0], w.points[i + 1][1] - w.points[i][1]);
+      if (w.closed && w.points.size() > 2)
+        length += std::hypot(w.points.front()[0] - w.points.back()[0], w.points.front()[1] - w.points.back()[1]);
+      e.walls += cells(length) * layers * (d == 3 ? cells(w.span[1] - w.span[0]) : 1.0);
+      continue;
+    }
+    double inner = 1, outer = 1;
+    for (int k = 0; k < d; ++k) {
+      const double n = cells(w.box.max[k] - w.box.min[k]);
+      inner *= n;
+      outer *= n + 2 * layers;
+    }
+    e.walls += w.kind == fsi::WallSpec::Kind::container ? outer - inner : inner;
+  }
+  for (const auto& st : s.structures) {
+    double extent[3] = {0, 0, 0};  // a bounding box of the shape
+    for (int k = 0; k < 3; ++k) {
+      switch (st.shape) {
+        case fsi::StructureSpec::Shape::box: extent[k] = st.size[std::size_t(k)]; break;
+        case fsi::StructureSpec::Shape::sphere: extent[k] = 2 * st.radius; break;
+        case fsi::StructureSpec::Shape::cylinder: extent[k] = std::max(2 * st.radius, st.length); break;
+        case fsi::StructureSpec::Shape::mesh: extent[k] = 0; break;  // its size is known once loaded
+      }
+      extent[k] *= st.scale;
+    }
+    double n = 1;
+    for (int k = 0; k < d; ++k) n *= cells(extent[k]);
+    e.structures += n;
+  }
+  if (!s.transitions.empty()) {
+    const double start = e.fluid + e.walls + e.structures;
+    e.reserved = s.capacity.max_particles > 0 ? std::max(0.0, double(s.capacity.max_particles) - start)
+                                              : (s.capacity.factor - 1.0) * start;
+  }
+  return e;
+}
+
 // Physical memory of this machine [bytes], 0 where unknown.
 double physical_memory_bytes() {
   const long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
@@ -520,8 +580,10 @@ fsi::Scene Reader::read(const std::string& yaml_text) {
       scene.dimensions = static_cast<int>(*d);
     }
     const int dims = scene.dimensions;
+    YAML::Mark spacing_mark;
     {
       MapView res(*this, top.need("resolution"), {"particle_spacing", "smoothing_ratio"});
+      spacing_mark = res.need("particle_spacing").mark;
       scene.particle_spacing = number(res.need("particle_spacing"), positive(), "m");
       if (auto v = res.get("smoothing_ratio")) scene.smoothing_ratio = number(*v, open_closed(0.5, 3.0));
     }
@@ -563,6 +625,26 @@ fsi::Scene Reader::read(const std::string& yaml_text) {
         fail(top.key_mark("capacity"), "'capacity' reserves room for particles that transitions create, but the "
                                        "scene has no 'transitions'");
       read_capacity(*v, scene.capacity);
+    }
+    {
+      // Every particle the scene would build, before anything is allocated (issue #27 item 3): a
+      // spacing that implies 1e12 of them once ended in std::bad_alloc with no location.
+      const ParticleEstimate e = estimate_particles(scene);
+      const double memory = physical_memory_bytes();
+      if (!(e.total() <= kMaxParticles) || (memory > 0 && e.total() * kMinBytesPerParticle > memory)) {
+        std::ostringstream os;
+        os << std::setprecision(3) << "at particle_spacing = " << fmt(scene.particle_spacing) << " m the scene would hold about "
+           << e.total() << " particles (fluid " << e.fluid << ", walls " << e.walls << ", structures " << e.structures;
+        if (e.reserved > 0) os << ", reserved for daughters " << e.reserved;
+        os << "), ";
+        if (!(e.total() <= kMaxParticles))
+          os << "more than the 4294967295 (2^32 - 1) a scene can hold";
+        else
+          os << e.total() * kMinBytesPerParticle / 1073741824.0 << " GiB at " << kMinBytesPerParticle
+             << " bytes a particle or more, more than this machine's " << memory / 1073741824.0 << " GiB";
+        os << "; use a larger spacing or a smaller scene";
+        fail(spacing_mark, os.str());
+      }
     }
     if (auto v = top.get("output")) {
       read_output(*v, scene.output);

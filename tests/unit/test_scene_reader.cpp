@@ -199,6 +199,8 @@ const BadScene kBadScenes[] = {
      "a free body's key on a prescribed structure is not ignored"},
     {"huge_polygon.yaml", 11, 32, "more than 1e308 particles at particle_spacing = 0.01 m",
      "a vertex at 1e308 is refused before any loop walks its lattice (issue #27: check spun for minutes)"},
+    {"huge_tank.yaml", 6, 32, "the scene would hold about 9.6e+12 particles (fluid 1e+06, walls 9.6e+12, structures 0)",
+     "walls that no machine holds are refused at the spacing before allocating (issue #27: std::bad_alloc)"},
     {"output_every_tiny.yaml", 10, 9, "'output: every' = 1e-300 s over an end time of 1 s asks for 1e+300 ParaView",
      "an output interval that no run could honour (issue #27: the run hung after its first step)"},
 };
