@@ -1440,8 +1440,10 @@ static std::string substep_message(const Scene& scene, const SubstepLimitError& 
   return os.str();
 }
 
-void Simulation::step() {
-  const double dt = solver_->next_time_step();
+void Simulation::step() { step(std::numeric_limits<double>::infinity()); }
+
+void Simulation::step(double max_dt) {
+  const double dt = std::min(solver_->next_time_step(), max_dt);
   particle_steps_ += store_.size();
   try {
     solver_->step(dt);
@@ -1521,11 +1523,14 @@ void Simulation::run(Observer& observer) {
   const auto t0 = clock::now();
   const double wall_before = wall_seconds_;
   auto last_progress = t0;
-  while (time() < scene_.end_time) {
-    step();
+  // The last step lands on the end time (a run asked for 0.001 s once simulated a whole larger step,
+  // issue #28 item 1); a remainder below the smallest allowed step counts as there.
+  const double end = scene_.end_time, close = scene_.numerics.min_time_step;
+  while (end - time() > close) {
+    step(end - time());
     const auto now = clock::now();
     wall_seconds_ = wall_before + std::chrono::duration<double>(now - t0).count();
-    const bool last = time() >= scene_.end_time;
+    const bool last = end - time() <= close;
     const bool output_now = (every > 0 && time() >= output_due()) || last;
     if (forces_due(output_now)) write_forces();
     if (output_now) {

@@ -148,7 +148,9 @@ class Simulation {
   void run(Observer& observer);
   // The last run() ended early because its observer asked it to stop.
   bool interrupted() const { return interrupted_; }
-  void step();
+  void step();  // one stable time step
+  // One time step of at most max_dt [s] (run() lands its last step on the end time this way).
+  void step(double max_dt);
 
   std::vector<double> probe_values();  // evaluated now (synchronises the store)
   // Force and torque of the fluid on every structure (scene order), from the last force pass.

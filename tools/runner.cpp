@@ -417,22 +417,30 @@ std::string read_text(const fs::path& p) {
 
 }  // namespace
 
+SceneOverrides overrides_of(const RunRequest& r) {
+  SceneOverrides o;
+  o.spacing = r.spacing;
+  o.end_time = r.end_time;
+  o.checkpoint_every = r.checkpoint_every;
+  return o;
+}
+
 void apply_overrides(fsi::Scene& scene, const RunRequest& r) {
   if (r.spacing) {
-    if (!(*r.spacing > 0)) throw std::invalid_argument("--spacing must be a positive length [m]");
+    if (!(*r.spacing > 0)) throw OptionError("turbid: --spacing must be a positive length [m]");
     scene.particle_spacing = *r.spacing;
   }
   if (r.end_time) {
-    if (!(*r.end_time > 0)) throw std::invalid_argument("--end must be a positive time [s]");
+    if (!(*r.end_time > 0)) throw OptionError("turbid: --end must be a positive time [s]");
     scene.end_time = *r.end_time;
   }
   if (r.checkpoint_every) {
-    if (!(*r.checkpoint_every >= 0)) throw std::invalid_argument("--checkpoint-every must be >= 0 [s]");
+    if (!(*r.checkpoint_every >= 0)) throw OptionError("turbid: --checkpoint-every must be >= 0 [s] (0 for none)");
     scene.output.checkpoint_every = *r.checkpoint_every;
   }
   if (r.end_time || r.checkpoint_every) {
     const std::string problem = schedule_problem(scene.end_time, scene.output);
-    if (!problem.empty()) throw std::invalid_argument("with the command-line options, " + problem);
+    if (!problem.empty()) throw OptionError("turbid: with the command-line options, " + problem);
   }
 }
 
@@ -694,10 +702,13 @@ nlohmann::json run_scene(const RunRequest& request) {
                                    "', which its checkpoint was not written with; put scene.yaml back as it was, or "
                                    "start a new run");
     }
+    // A resume's scene was checked when the run started; --end and --checkpoint-every on it are
+    // checked here (and the end against the checkpoint's time below).
+    apply_overrides(scene, request);
   } else {
-    scene = read_scene_file(request.scene_file.string());
+    // A new run's overrides go in before the scene's checks, which they meet like the scene's own.
+    scene = read_scene_file(request.scene_file.string(), {}, overrides_of(request));
   }
-  apply_overrides(scene, request);
   if (resume_time && !(scene.end_time > *resume_time)) {
     // Nothing to run: say so and leave the run directory (and its run.json) as it is.
     std::ostringstream os;

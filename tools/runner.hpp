@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fsi/scene.hpp"
+#include "tools/scene_reader.hpp"
 
 namespace turbid::tools {
 
@@ -24,8 +25,11 @@ struct RunRequest {
   bool progress = true;                      // progress line on stderr
 };
 
-// Applies command-line overrides to a parsed scene (spacing must be > 0, end > 0).
+// Applies command-line overrides to a parsed scene (spacing must be > 0, end > 0); a resume uses
+// it. A new run reads its scene with the overrides instead (overrides_of, read_scene_file), so that
+// they meet every check of the scene's own values.
 void apply_overrides(fsi::Scene& scene, const RunRequest& request);
+SceneOverrides overrides_of(const RunRequest& request);
 
 // Runs to the end. Returns run.json's content; "status" is "completed" or "blow-up"
 // (then "error" holds the diagnosis). Throws SceneError / std::runtime_error for bad input.

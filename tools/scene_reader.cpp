@@ -287,8 +287,8 @@ class MapView {
 
 class Reader {
  public:
-  explicit Reader(std::string file, std::string relative_to = {})
-      : file_(std::move(file)), relative_to_(std::move(relative_to)) {}
+  explicit Reader(std::string file, std::string relative_to = {}, SceneOverrides overrides = {})
+      : file_(std::move(file)), relative_to_(std::move(relative_to)), overrides_(overrides) {}
 
   fsi::Scene read(const std::string& yaml_text);
 
@@ -474,7 +474,8 @@ class Reader {
   void read_capacity(const Value& v, fsi::CapacitySpec& c) const;
 
   std::string file_;
-  std::string relative_to_;  // directory of relative mesh paths; empty: the scene file's
+  std::string relative_to_;
+  SceneOverrides overrides_;  // directory of relative mesh paths; empty: the scene file's
 };
 
 // --- MapView ------------------------------------------------------------------------------------
@@ -585,11 +586,13 @@ fsi::Scene Reader::read(const std::string& yaml_text) {
       MapView res(*this, top.need("resolution"), {"particle_spacing", "smoothing_ratio"});
       spacing_mark = res.need("particle_spacing").mark;
       scene.particle_spacing = number(res.need("particle_spacing"), positive(), "m");
+      if (overrides_.spacing) scene.particle_spacing = *overrides_.spacing;
       if (auto v = res.get("smoothing_ratio")) scene.smoothing_ratio = number(*v, open_closed(0.5, 3.0));
     }
     {
       MapView time(*this, top.need("time"), {"end", "cfl"});
       scene.end_time = number(time.need("end"), positive(), "s");
+      if (overrides_.end_time) scene.end_time = *overrides_.end_time;
       if (auto v = time.get("cfl")) scene.numerics.cfl = number(*v, open_closed(0.0, 1.0));
     }
     scene.gravity = Vec3d{0, 0, 0};
@@ -646,11 +649,11 @@ fsi::Scene Reader::read(const std::string& yaml_text) {
         fail(spacing_mark, os.str());
       }
     }
-    if (auto v = top.get("output")) {
-      read_output(*v, scene.output);
-      const std::string problem = schedule_problem(scene.end_time, scene.output);
-      if (!problem.empty()) fail(v->mark, problem);
-    }
+    const auto output = top.get("output");
+    if (output) read_output(*output, scene.output);
+    if (overrides_.checkpoint_every) scene.output.checkpoint_every = *overrides_.checkpoint_every;
+    if (const std::string problem = schedule_problem(scene.end_time, scene.output); !problem.empty())
+      fail(output ? output->mark : top.key_mark("time"), problem);
   } catch (const YAML::Exception& e) {
     // Walking a parsed tree should not throw; if yaml-cpp does, keep the promised message form.
     fail(e.mark, "cannot read the scene: " + e.msg);
@@ -1635,7 +1638,19 @@ fsi::Scene read_scene_string(const std::string& yaml_text, const std::string& fi
   return Reader(file_name_for_messages).read(yaml_text);
 }
 
-fsi::Scene read_scene_file(const std::string& path, const std::string& relative_to) {
+fsi::Scene read_scene_file(const std::string& path, const std::string& relative_to, const SceneOverrides& overrides) {
+  // The command-line values themselves: the same ranges as the scene's keys.
+  const auto refuse = [](const char* option, double v, const char* range) {
+    std::ostringstream os;
+    os << std::setprecision(12) << "turbid: " << option << " " << v << ": must be " << range;
+    throw OptionError(os.str());
+  };
+  if (overrides.spacing && !(*overrides.spacing > 0 && std::isfinite(*overrides.spacing)))
+    refuse("--spacing", *overrides.spacing, "a positive length [m]");
+  if (overrides.end_time && !(*overrides.end_time > 0 && std::isfinite(*overrides.end_time)))
+    refuse("--end", *overrides.end_time, "a positive time [s]");
+  if (overrides.checkpoint_every && !(*overrides.checkpoint_every >= 0 && std::isfinite(*overrides.checkpoint_every)))
+    refuse("--checkpoint-every", *overrides.checkpoint_every, "a time >= 0 [s] (0 for none)");
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))
     throw SceneError(path + ":1:1: error: this is a directory, not a scene file");
@@ -1648,7 +1663,18 @@ fsi::Scene read_scene_file(const std::string& path, const std::string& relative_
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw SceneError(path + ":1:1: error: cannot read the scene file");
-  return Reader(path, relative_to).read(text.str());
+  if (!overrides.any()) return Reader(path, relative_to).read(text.str());
+  try {
+    return Reader(path, relative_to, overrides).read(text.str());
+  } catch (const SceneError& e) {
+    std::ostringstream os;
+    os << std::setprecision(12) << e.what() << " (with";
+    if (overrides.spacing) os << " --spacing " << *overrides.spacing;
+    if (overrides.end_time) os << " --end " << *overrides.end_time;
+    if (overrides.checkpoint_every) os << " --checkpoint-every " << *overrides.checkpoint_every;
+    os << " from the command line)";
+    throw SceneError(os.str());
+  }
 }
 
 }  // namespace turbid::tools

@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 
 #include "fsi/bullet_world.hpp"
 #include "sph/backend.hpp"
@@ -32,17 +33,24 @@ int cmd_info() {
 
 int main(int argc, char** argv) {
   CLI::App app{"turbid: weakly compressible SPH with fluid-structure interaction"};
-  app.require_subcommand(1);
+  // At most one command; none is answered below (an unknown word is then named by CLI11 as an
+  // argument it did not expect, instead of "A subcommand is required").
+  app.require_subcommand(0, 1);
+  app.set_version_flag("--version", std::string("turbid ") + TURBID_VERSION + " (git " + TURBID_GIT_REVISION + ")");
+  app.footer(
+      "Exit codes: 0 done; 1 a run-time error; 2 a scene error (FILE:LINE:COL: error:) or a refused option value;\n"
+      "3 a run that blew up or failed (run.json says why); 130 / 143 stopped by Ctrl-C / SIGTERM with a checkpoint;\n"
+      "105-114 command-line syntax (CLI11: unknown option or command, missing value, value out of range).\n");
 
   turbid::tools::RunRequest req;
   std::string scene_file, out, resume;
-  double end = 0, spacing = 0, checkpoint_every = -1;
+  std::optional<double> end, spacing, checkpoint_every;
   bool quiet = false;
   auto* run = app.add_subcommand("run", "Run a scene and write its results");
   run->add_option("scene", scene_file, "Scene file (YAML)");
   run->add_option("--out", out, "Run directory (default: runs/<scene name>)");
   run->add_option("--backend", req.backend, "auto | cpu | cuda")->check(CLI::IsMember({"auto", "cpu", "cuda"}));
-  run->add_option("--threads", req.threads, "CPU threads (default: all)")->check(CLI::NonNegativeNumber);
+  run->add_option("--threads", req.threads, "CPU threads, 0 = all (default)")->check(CLI::Range(0, 4096));
   run->add_option("--end", end, "End time [s], overrides the scene");
   run->add_option("--spacing", spacing, "Particle spacing [m], overrides the scene");
   run->add_option("--checkpoint-every", checkpoint_every, "Checkpoint interval [s] (0 = none)");
@@ -52,7 +60,7 @@ int main(int argc, char** argv) {
   auto* check = app.add_subcommand("check", "Validate a scene; print particle counts and memory");
   std::string check_file;
   check->add_option("scene", check_file, "Scene file (YAML)")->required();
-  double check_spacing = 0;
+  std::optional<double> check_spacing;
   check->add_option("--spacing", check_spacing, "Particle spacing [m], overrides the scene");
 
   app.add_subcommand("info", "Version, build options, backends and GPUs");
@@ -60,12 +68,15 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   try {
+    if (app.get_subcommands().empty()) {
+      std::fprintf(stderr, "turbid: give a command: run, check or info (turbid --help lists them)\n");
+      return 2;
+    }
     if (app.got_subcommand("info")) return cmd_info();
     if (app.got_subcommand("check")) {
-      auto scene = turbid::tools::read_scene_file(check_file);
-      turbid::tools::RunRequest r;
-      if (check_spacing != 0) r.spacing = check_spacing;
-      turbid::tools::apply_overrides(scene, r);
+      turbid::tools::SceneOverrides o;
+      o.spacing = check_spacing;
+      const auto scene = turbid::tools::read_scene_file(check_file, {}, o);
       std::cout << turbid::tools::describe_scene(scene) << "scene OK\n";
       return 0;
     }
@@ -78,9 +89,9 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "turbid run: give either a scene file or --resume DIR, not both\n");
       return 2;
     }
-    if (end != 0) req.end_time = end;
-    if (spacing != 0) req.spacing = spacing;
-    if (checkpoint_every >= 0) req.checkpoint_every = checkpoint_every;
+    req.end_time = end;
+    req.spacing = spacing;
+    req.checkpoint_every = checkpoint_every;
     req.progress = !quiet;
     if (!resume.empty()) req.resume = resume;
     req.scene_file = scene_file;
@@ -124,6 +135,9 @@ int main(int argc, char** argv) {
     std::printf("results in %s: %sprobes.csv, %srun.json\n", dir.c_str(), vtk ? "particles.pvd (open in ParaView), " : "",
                 forces ? "forces.csv (tools/plot_forces draws it), " : "");
     return 0;
+  } catch (const turbid::tools::OptionError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 2;
   } catch (const turbid::tools::SceneError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 2;
