@@ -1,6 +1,6 @@
 // Throughput benchmark: the 3D dam break with an obstacle (scenes/dam_break_obstacle_3d.yaml),
 // reported in particle-steps per second counting fluid and wall particles, as the
-// DualSPHysics figures in ../shared/reference/performance-anchors.md do.
+// DualSPHysics figures in docs/reference/performance-anchors.md do.
 //
 //   build/bin/turbid_bench --benchmark_filter=DamBreakObstacle3D --benchmark_repetitions=3
 //

@@ -191,7 +191,7 @@ def hydrostatic_errors(run_dir):
 # ---------------------------------------------------------------------------------------------
 # Metric by scene name (tools/convergence)
 
-# Schaefer & Turek (1996) 2D-1 (../shared/reference/data/dfg_cylinder_reference_values.csv).
+# Schaefer & Turek (1996) 2D-1 (scenes/reference/dfg_cylinder_reference_values.csv).
 DFG_CD = 5.57953523384
 DFG_FROM = 2.5  # s: the wake has formed
 

@@ -2,7 +2,7 @@
 // case 2D-1 (scenes/cylinder_2d_re20.yaml: Re = 20, parabolic inflow through an inlet buffer zone,
 // outlet zone, no-slip mDBC walls and cylinder, laminar viscosity).
 //
-// Reference: C_D = 5.5795 (../shared/reference/data/dfg_cylinder_reference_values.csv; bounds of
+// Reference: C_D = 5.5795 (scenes/reference/dfg_cylinder_reference_values.csv; bounds of
 // the 1996 paper 5.57-5.59), C_D = 2 F_D / (rho U_mean^2 D).
 // Quick mode (CI): D/dx = 10 (dx = 0.01 m), to t = 4 s, C_D averaged over 2.5 s <= t <= 4 s (the
 // wake has formed after ~2 s). Measured: C_D = 5.800, +3.95% (the scene runs with particle
