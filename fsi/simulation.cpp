@@ -472,6 +472,11 @@ std::vector<std::string> check_layout(const Scene& s, const sph::Domain& domain,
       }
   // 2. Structures inside each other, or inside a wall: an error when one of them moves (contacts
   //    and forces would start from an overlap), a warning when both are fixed.
+  std::vector<PointHash> walls;  // each wall's particles, hashed once
+  if (!s.structures.empty()) {
+    walls.reserve(s.walls.size());
+    for (std::size_t w = 0; w < s.walls.size(); ++w) walls.emplace_back(x, wall_first[w], wall_first[w + 1], dx, d);
+  }
   for (std::size_t a = 0; a < s.structures.size(); ++a) {
     for (std::size_t b = 0; b < s.structures.size(); ++b) {
       if (a == b) continue;
@@ -492,10 +497,9 @@ std::vector<std::string> check_layout(const Scene& s, const sph::Domain& domain,
       warnings.push_back(os.str());
     }
     for (std::size_t w = 0; w < s.walls.size(); ++w) {
-      const PointHash wall(x, wall_first[w], wall_first[w + 1], dx, d);
       std::size_t inside = 0;
       for (std::size_t i = structure_first[a]; i < structure_first[a + 1]; ++i)
-        if (wall.any_within(x[i], touch)) ++inside;
+        if (walls[w].any_within(x[i], touch)) ++inside;
       if (inside == 0) continue;
       const bool error = moves(s.structures[a]);
       std::ostringstream os;

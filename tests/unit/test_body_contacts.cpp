@@ -120,6 +120,19 @@ constraints:
   EXPECT_LT(angle, 1e-9);
 }
 
+// The message of the exception the first step of `yaml`'s scene throws ("" if none).
+std::string first_step_error(const std::string& yaml) {
+  fsi::Simulation sim(scene_of(yaml), cpu());
+  sim.start();
+  try {
+    sim.step();
+  } catch (const std::exception& e) {
+    std::printf("[ measured ] %s\n", e.what());
+    return e.what();
+  }
+  return "";
+}
+
 // A spring too stiff for the body substeps (issue #27 item 2): the run stops with a message that
 // names the constraint's scene line, the key and a value that would do; that value, halved, runs.
 TEST(BodyConstraints, TooStiffASpringIsNamedWithAStiffnessThatWouldDo) {
@@ -130,15 +143,7 @@ constraints:
   - {type: spring, name: hang, a: {structure: block, point: [0.5, 1.0]}, b: {anchor: [0.5, 1.3]}, stiffness: )" +
            k + "}\n";
   };
-  fsi::Simulation sim(scene_of(yaml("1e20")), cpu());
-  sim.start();
-  std::string message;
-  try {
-    sim.step();
-  } catch (const std::exception& e) {
-    message = e.what();
-  }
-  std::printf("[ measured ] %s\n", message.c_str());
+  const std::string message = first_step_error(yaml("1e20"));
   ASSERT_NE(message.find(": error: constraint 'hang' needs body substeps"), std::string::npos) << message;
   EXPECT_NE(message.find("lower its 'stiffness' (1e+20 N/m)"), std::string::npos) << message;
   // The scene's line of the constraint: the one after 'constraints:'.
@@ -194,15 +199,7 @@ TEST(BodyContacts, TooStiffAContactIsNamedWithAModulusThatWouldDo) {
            "1000,\n     contact: {youngs_modulus: " +
            e + ", poisson_ratio: 0.3, restitution: 0.5, friction: 0.3}}\n";
   };
-  fsi::Simulation sim(scene_of(yaml("1e40")), cpu());
-  sim.start();
-  std::string message;
-  try {
-    sim.step();
-  } catch (const std::exception& e) {
-    message = e.what();
-  }
-  std::printf("[ measured ] %s\n", message.c_str());
+  const std::string message = first_step_error(yaml("1e40"));
   ASSERT_NE(message.find(": error: the contacts of structure 'ball' need body substeps"), std::string::npos) << message;
   const std::string text = yaml("1e40");
   const int line = 1 + int(std::count(text.begin(), text.begin() + long(text.find("  - {name: ball")), '\n'));

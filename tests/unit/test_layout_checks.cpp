@@ -18,15 +18,15 @@ using namespace turbid;
 using test::cpu;
 using test::scene_of;
 
+// A 2D scene's head: spacing dx [m], water of sound speed c0 [m/s]; fluids, walls and the rest follow.
+std::string head(const std::string& name, const std::string& dx, const std::string& c0) {
+  return "name: " + name + "\ndimensions: 2\nresolution: {particle_spacing: " + dx +
+         ", smoothing_ratio: 1.3}\ntime: {end: 0.01}\nmaterials:\n  water: {density: 1000, sound_speed: " + c0 + "}\n";
+}
+
 // A 1 x 0.6 m tank with 0.4 x 0.3 m of water at dx = 0.02 m; `extra` is appended (walls, structures).
 std::string tank(const std::string& walls_extra, const std::string& rest, const std::string& domain = "") {
-  return R"(name: layout
-dimensions: 2
-resolution: {particle_spacing: 0.02, smoothing_ratio: 1.3}
-time: {end: 0.01}
-materials:
-  water: {density: 1000, sound_speed: 20}
-fluids:
+  return head("layout", "0.02", "20") + R"(fluids:
   - {material: water, box: {min: [0, 0], max: [0.4, 0.3]}}
 walls:
   - box: {min: [0, 0], max: [1.0, 0.6]}
@@ -52,6 +52,18 @@ void expect_at(const std::string& message, const std::string& yaml, const std::s
   const std::string at = "test.yaml:" + std::to_string(line_of(yaml, text)) + ":";
   EXPECT_EQ(message.rfind(at, 0), 0u) << "'" << at << "' at the start of: " << message;
   EXPECT_NE(message.find(std::string(": ") + kind + ": "), std::string::npos) << message;
+}
+
+// The one warning building the scene gives ("" and a failure if it gives none or several).
+std::string only_warning(const std::string& yaml) {
+  const fsi::Simulation sim(scene_of(yaml), cpu());
+  const auto& w = sim.summary().warnings;
+  if (w.size() != 1) {
+    ADD_FAILURE() << w.size() << " warnings, expected 1";
+    return "";
+  }
+  std::printf("[ measured ] %s\n", w[0].c_str());
+  return w[0];
 }
 
 TEST(LayoutChecks, AStructureReachingOutOfTheDomainIsRefused) {
@@ -88,11 +100,9 @@ TEST(LayoutChecks, AStructureInAWallIsRefusedWhenItMoves) {
   // The pipe's centre 0.02 m below the floor: half of it in the floor's wall layers.
   const std::string s = "structures:\n  - {name: pipe, cylinder: {radius: 0.05}, position: [0.7, -0.02]MOTION}\n";
   const std::string fixed = tank("", test::replace(s, "MOTION", ""));
-  const fsi::Simulation sim(scene_of(fixed), cpu());
-  ASSERT_EQ(sim.summary().warnings.size(), 1u);
-  std::printf("[ measured ] %s\n", sim.summary().warnings[0].c_str());
-  expect_at(sim.summary().warnings[0], fixed, "  - {name: pipe", "warning");
-  EXPECT_NE(sim.summary().warnings[0].find("overlaps wall 1 of 'walls'"), std::string::npos);
+  const std::string w = only_warning(fixed);
+  expect_at(w, fixed, "  - {name: pipe", "warning");
+  EXPECT_NE(w.find("overlaps wall 1 of 'walls'"), std::string::npos) << w;
   const std::string moving = tank("", test::replace(s, "MOTION", ", motion: free, density: 2000"));
   const std::string m = refusal(moving);
   expect_at(m, moving, "  - {name: pipe", "error");
@@ -114,36 +124,24 @@ TEST(LayoutChecks, AWallDrawnThroughTheFluidIsRefused) {
 }
 
 TEST(LayoutChecks, FluidWithNothingBeneathItIsWarnedAbout) {
-  const std::string head = R"(name: falling
-dimensions: 2
-resolution: {particle_spacing: 0.02, smoothing_ratio: 1.3}
-time: {end: 0.01}
-materials:
-  water: {density: 1000, sound_speed: 20}
-)";
+  const std::string top = head("falling", "0.02", "20");
   // Beside the tank: nothing below any of it.
-  const std::string beside = head + R"(fluids:
+  const std::string beside = top + R"(fluids:
   - {material: water, box: {min: [0, 0], max: [0.4, 0.3]}}
   - {material: water, box: {min: [1.2, 0.1], max: [1.4, 0.3]}}
 walls:
   - box: {min: [0, 0], max: [1.0, 0.6]}
 )";
-  const fsi::Simulation apart(scene_of(beside), cpu());
-  ASSERT_EQ(apart.summary().warnings.size(), 1u);
-  const std::string& m = apart.summary().warnings[0];
-  std::printf("[ measured ] %s\n", m.c_str());
+  const std::string m = only_warning(beside);
   expect_at(m, beside, "  - {material: water, box: {min: [1.2", "warning");
   EXPECT_NE(m.find("has nothing beneath it: 100 of its 100 particles"), std::string::npos) << m;
   // On a 0.2 m wide obstacle, 0.4 m of water: the overhang falls (a warning: it may be meant).
-  const std::string ledge = head + R"(fluids:
+  const std::string ledge = top + R"(fluids:
   - {material: water, box: {min: [0.4, 0.2], max: [0.8, 0.3]}}
 walls:
   - solid_box: {min: [0.5, 0.0], max: [0.7, 0.2]}
 )";
-  const fsi::Simulation sim(scene_of(ledge), cpu());
-  ASSERT_EQ(sim.summary().warnings.size(), 1u);
-  const std::string& w = sim.summary().warnings[0];
-  std::printf("[ measured ] %s\n", w.c_str());
+  const std::string w = only_warning(ledge);
   expect_at(w, ledge, "  - {material: water", "warning");
   // 20 x 5 particles; a column is held where an obstacle particle (x = 0.51 ... 0.69) lies in its
   // cell of side dx or the next one: fluid x = 0.49 ... 0.71, 12 of the 20 columns, so 8 x 5 fall.
@@ -160,13 +158,7 @@ namespace {
 // every fluid particle next to the wall stands exactly dx from it; `turbid check` lists both
 // extents and volumes.
 TEST(LayoutChecks, ABlockStatedUpToAWallStopsAtTheWallAsBuilt) {
-  const std::string yaml = R"(name: stated
-dimensions: 2
-resolution: {particle_spacing: 0.03, smoothing_ratio: 1.3}
-time: {end: 0.01}
-materials:
-  water: {density: 1000, sound_speed: 40}
-fluids:
+  const std::string yaml = head("stated", "0.03", "40") + R"(fluids:
   - {material: water, box: {min: [1.0, 0], max: [3.22, 0.55]}}
 walls:
   - box: {min: [0, 0], max: [3.22, 1.0]}
@@ -209,13 +201,7 @@ TEST(LayoutChecks, FluidInAnObstaclesCellsIsLeftOutWithAWarning) {
   // solid_box 0.5 to 0.612 at dx 0.02: 5.6 -> 6 cells from 0.5, built to 0.62. Water from 0.612
   // (its own lattice outside any tank: centres 0.622, 0.642, ...): the column at 0.622 lies within
   // dx/4 of the obstacle's built cells and is left out, one per row (5 rows).
-  const std::string yaml = R"(name: obstacle
-dimensions: 2
-resolution: {particle_spacing: 0.02, smoothing_ratio: 1.3}
-time: {end: 0.01}
-materials:
-  water: {density: 1000, sound_speed: 20}
-fluids:
+  const std::string yaml = head("obstacle", "0.02", "20") + R"(fluids:
   - {material: water, box: {min: [0.612, 0], max: [0.812, 0.1]}}
 walls:
   - solid_box: {min: [0.5, -0.06], max: [0.612, 0.1]}

@@ -74,7 +74,7 @@ output: {every: 0.01, vtk: true}
 TEST(RunFailures, AFailedWriteEndsWithRunJsonAndTheCheckpointBeforeItResumes) {
   const fs::path dir = scratch("write");
   fs::create_directories(dir / "out" / "particles_0002.vtp");
-  std::ofstream(dir / "scene.yaml") << R"(name: failed_write
+  const auto report = run(dir, R"(name: failed_write
 dimensions: 2
 resolution: {particle_spacing: 0.02}
 time: {end: 0.05}
@@ -85,13 +85,7 @@ walls:
 fluids:
   - {material: water, box: {min: [0, 0], max: [0.2, 0.2]}}
 output: {every: 0.01, vtk: true, checkpoint_every: 0.005}
-)";
-  turbid::tools::RunRequest r;
-  r.scene_file = dir / "scene.yaml";
-  r.out = dir / "out";
-  r.backend = "cpu";
-  r.progress = false;
-  const auto report = turbid::tools::run_scene(r);
+)");
   ASSERT_EQ(report.at("status"), "failed");
   const std::string error = report.at("error");
   std::printf("[ measured ] failed at t = %.4f s: %s\n", report.at("simulated_time").get<double>(), error.c_str());
