@@ -924,9 +924,8 @@ std::size_t particle_capacity(const Scene& scene, std::size_t initial) {
   if (scene.capacity.max_particles > 0) {
     // Fewer than the start holds would refuse every split (it was once raised silently).
     if (scene.capacity.max_particles < initial) {
-      const SourceLocation& w = scene.capacity.where;
       std::ostringstream os;
-      os << w.file << ":" << w.line << ":" << w.column << ": error: capacity: max_particles = "
+      os << at_text(scene.capacity.where, "error") << "capacity: max_particles = "
          << scene.capacity.max_particles << " is below the " << initial
          << " particles the scene starts with (fluid, walls and structures), so no particle could ever split; "
             "give at least " << initial << " plus room for the daughters, or 'factor' (e.g. 2) instead";
@@ -1330,7 +1329,7 @@ void Simulation::build_particles() {
     for (const auto& [where, n] : wall_drops) {
       summary_.fluid_removed_by_walls += n;
       std::ostringstream os;
-      os << where.file << ":" << where.line << ":" << where.column << ": warning: " << n
+      os << at_text(where, "warning") << n
          << " lattice points of this fluid block lie in the cells of a wall as built (walls are whole cells from "
             "their min corner, up to dx/2 off the stated box) and are left out; state the block up to the wall's "
             "built extent (turbid check lists it) to silence this";
@@ -1405,13 +1404,10 @@ static std::string substep_message(const Scene& scene, const SubstepLimitError& 
   std::ostringstream os;
   os << std::setprecision(3);
   const double ratio = e.wanted / BodyCoupling::kMaxSubsteps;  // > 1
-  const auto at = [&](const SourceLocation& w) {
-    os << w.file << ":" << w.line << ":" << w.column << ": error: ";
-  };
   if (e.source == SubstepLimitError::Source::constraint && e.index >= 0 &&
       std::size_t(e.index) < scene.constraints.size()) {
     const ConstraintSpec& c = scene.constraints[std::size_t(e.index)];
-    at(c.where);
+    os << at_text(c.where, "error");
     os << "constraint '" << c.name << "' needs body substeps of " << e.substep << " s, " << e.wanted
        << " of them in the fluid step of " << e.dt << " s (at most " << BodyCoupling::kMaxSubsteps << "): ";
     if (c.type == ConstraintSpec::Type::hinge)
@@ -1429,7 +1425,7 @@ static std::string substep_message(const Scene& scene, const SubstepLimitError& 
   } else if (e.source == SubstepLimitError::Source::contact && e.index >= 0 &&
              std::size_t(e.index) < scene.structures.size()) {
     const StructureSpec& st = scene.structures[std::size_t(e.index)];
-    at(st.where);
+    os << at_text(st.where, "error");
     os << "the contacts of structure '" << st.name << "' need body substeps of " << e.substep << " s, " << e.wanted
        << " of them in the fluid step of " << e.dt << " s (at most " << BodyCoupling::kMaxSubsteps << "): lower ";
     if (st.contact.given && st.contact.youngs_modulus > 0)

@@ -14,6 +14,13 @@
 
 namespace {
 
+// A message that starts "FILE:LINE:COL: error:" (a scene item refused past the reader): printed as
+// it is, where editors and log matchers look for the location.
+bool located(const std::string& message) {
+  const auto at = message.find(": error: ");
+  return at != std::string::npos && at < message.find(' ');
+}
+
 int cmd_info() {
   std::printf("turbid %s (git %s, %s build)\n", TURBID_VERSION, TURBID_GIT_REVISION, TURBID_BUILD_TYPE);
   std::printf("precision        particle fields float32, conservation sums float64\n");
@@ -117,8 +124,7 @@ int main(int argc, char** argv) {
     if (report.at("status") != "completed") {
       // A located message (a scene item refused during the run) keeps FILE:LINE:COL at the start.
       const std::string error = report.value("error", std::string("run failed"));
-      const auto at = error.find(": error: ");
-      if (at != std::string::npos && at < error.find(' ')) std::fprintf(stderr, "%s\n", error.c_str());
+      if (located(error)) std::fprintf(stderr, "%s\n", error.c_str());
       else std::fprintf(stderr, "turbid: error: %s\n", error.c_str());
       std::fprintf(stderr, "turbid: outputs up to the failure are in %s\n", dir.c_str());
       if (std::filesystem::exists(std::filesystem::path(dir) / "checkpoint" / "checkpoint.json"))
@@ -147,7 +153,7 @@ int main(int argc, char** argv) {
     // Such a message is a scene error found past the reader (a material that the physics refuses,
     // a body whose inertia is not finite): exit 2 like the reader's own.
     const std::string what = e.what();
-    if (what.find(": error: ") != std::string::npos && what.find(": error: ") < what.find(' ')) {
+    if (located(what)) {
       std::fprintf(stderr, "%s\n", what.c_str());
       return 2;
     }
