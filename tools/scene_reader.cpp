@@ -4,6 +4,7 @@
 // unknown material) run while reading, after the items they refer to, so they can still point at
 // the YAML node. The first error stops the read: a scene either parses completely or not at all.
 #include "tools/scene_reader.hpp"
+#include "tools/yaml_syntax.hpp"
 
 #include "fsi/prescribed_path.hpp"
 #include "fsi/bullet_world.hpp"
@@ -549,6 +550,13 @@ fsi::Scene Reader::read(const std::string& yaml_text) {
   try {
     documents = YAML::LoadAll(yaml_text);
   } catch (const YAML::Exception& e) {
+    // yaml-cpp often gives up a line after the mistake; point at the bracket or quote left open.
+    if (const auto hint = explain_yaml_syntax_error(yaml_text, e.mark.line, e.mark.column, e.msg)) {
+      YAML::Mark m = e.mark;
+      m.line = hint->line;
+      m.column = hint->column;
+      fail(m, "invalid YAML: " + hint->message);
+    }
     fail(e.mark, "invalid YAML: " + e.msg);
   }
   if (documents.empty() || (documents.size() == 1 && documents[0].IsNull()))
@@ -663,7 +671,8 @@ fsi::Scene Reader::read(const std::string& yaml_text) {
 
 void Reader::read_numerics(const Value& v, fsi::NumericsSpec& n) const {
   MapView m(*this, v, {"kernel", "density_diffusion", "viscosity", "boundary", "shifting", "min_time_step",
-                                "max_density_variation", "interface_correction", "split_relaxation"});
+                                "max_density_variation", "interface_correction", "split_relaxation",
+                                "max_fluid_behind_walls"});
   // Density diffusion between materials: the seed paper's ghost density (eq. 3), or none.
   if (auto ic = m.get("interface_correction"))
     n.interface_correction = choice(*ic, {"ghost_density", "none"}) == 0;
@@ -728,6 +737,11 @@ void Reader::read_numerics(const Value& v, fsi::NumericsSpec& n) const {
   if (auto t = m.get("min_time_step")) n.min_time_step = number(*t, positive(), "s");
   // |rho / rho0 - 1| above this stops the run as a blow-up.
   if (auto t = m.get("max_density_variation")) n.density_ratio_limit = number(*t, positive());
+  // More fluid particles than this behind a wall or structure surface at an output stops the run.
+  if (auto t = m.get("max_fluid_behind_walls")) {
+    n.max_fluid_behind_walls = std::uint64_t(integer(*t, 0, "a whole number of particles from 0 to 1000000"));
+    n.max_fluid_behind_walls_where = where(t->mark);
+  }
 }
 
 // transitions: [{from, to, when: {effective_shear_stress_above}, where, split, levels}]
