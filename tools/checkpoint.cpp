@@ -21,7 +21,7 @@ using nlohmann::json;
 namespace {
 
 constexpr const char* kFormat = "turbid-checkpoint";
-constexpr int kVersion = 1;
+constexpr int kVersion = 2;  // 2: digests of the state and the field list
 
 static_assert(std::endian::native == std::endian::little, "checkpoints store little-endian bytes");
 
@@ -53,6 +53,21 @@ std::string hex(std::uint64_t v) {
   char buf[17];
   std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
   return buf;
+}
+
+// Digests of the state block and of the field list (names, sizes and checksums) as written: an
+// edit of checkpoint.json after the fact (a time changed by hand, a field file replaced and its
+// checksum recomputed) no longer matches them (issue #27 item 5). Not a seal against intent, a
+// guard against edits: whoever recomputes these can pass it.
+nlohmann::json digests_of(const nlohmann::json& meta) {
+  const std::string state = meta.contains("state") ? meta["state"].dump() : std::string("null");
+  std::string fields = std::to_string(meta.value("count", std::size_t(0)));
+  if (meta.contains("fields"))
+    for (const auto& f : meta["fields"]) {
+      fields.push_back('\n');
+      fields.append(f.dump());
+    }
+  return {{"state", hex(fnv1a64(state.data(), state.size()))}, {"fields", hex(fnv1a64(fields.data(), fields.size()))}};
 }
 
 void check_file_name(const std::string& name) {
@@ -116,8 +131,9 @@ void write_checkpoint(const fs::path& dir_in, const sph::ParticleStore& store, c
                       {"bytes", bytes},
                       {"fnv1a64", hex(fnv1a64(store.raw(id), bytes))}});
   }
-  const json meta = {{"format", kFormat}, {"version", kVersion}, {"byte_order", "little"},
-                     {"count", n},        {"fields", fields},    {"state", state}};
+  json meta = {{"format", kFormat}, {"version", kVersion}, {"byte_order", "little"},
+               {"count", n},        {"fields", fields},    {"state", state}};
+  meta["digests"] = digests_of(meta);
   write_text_atomic(tmp / "checkpoint.json", meta.dump(2) + "\n");
   sync_directory(tmp);
 
@@ -156,11 +172,30 @@ json read_meta(const fs::path& dir, const fs::path& dir_in) {
   return {};
 }
 
+// Version 2 on: the digests must match what the file holds now.
+void check_digests(const json& meta, const fs::path& meta_file) {
+  if (!meta.is_object() || !meta.contains("version") || !meta["version"].is_number_integer() ||
+      meta["version"].get<int>() < 2)
+    return;  // version 1 (before digests), or not a checkpoint: the format checks say so
+  if (!meta.contains("digests") || !meta["digests"].is_object())
+    bad(meta_file, "has no 'digests' (version 2 writes them): it was edited after it was written");
+  const json now = digests_of(meta);
+  const json& saved = meta["digests"];
+  if (saved.value("state", std::string{}) != now["state"].get<std::string>())
+    bad(meta_file, "the 'state' block differs from the one written with this checkpoint (its digest does not match): "
+                   "it was edited after the checkpoint was written; resume from an unedited checkpoint");
+  if (saved.value("fields", std::string{}) != now["fields"].get<std::string>())
+    bad(meta_file, "the 'fields' list (names, sizes or checksums) differs from the one written with this checkpoint "
+                   "(its digest does not match): a field file was replaced and its checksum edited; resume from an "
+                   "unedited checkpoint");
+}
+
 }  // namespace
 
 json read_checkpoint_state(const fs::path& dir_in) {
   const fs::path dir = checkpoint_directory(dir_in);
   const json meta = read_meta(dir, dir_in);
+  check_digests(meta, dir / "checkpoint.json");
   if (!meta.contains("state")) bad(dir / "checkpoint.json", "has no 'state'");
   return meta["state"];
 }
@@ -169,6 +204,7 @@ json read_checkpoint(const fs::path& dir_in, sph::ParticleStore& store) {
   const fs::path dir = checkpoint_directory(dir_in);
   const fs::path meta_file = dir / "checkpoint.json";
   const json meta = read_meta(dir, dir_in);
+  check_digests(meta, meta_file);
 
   struct Entry {
     sph::FieldId id;
@@ -180,7 +216,7 @@ json read_checkpoint(const fs::path& dir_in, sph::ParticleStore& store) {
   std::size_t count = 0;
   try {
     if (meta.value("format", std::string{}) != kFormat) bad(meta_file, "not a turbid checkpoint (format)");
-    if (meta.at("version").get<int>() != kVersion)
+    if (meta.at("version").get<int>() != kVersion && meta.at("version").get<int>() != 1)
       bad(meta_file, "version " + meta.at("version").dump() + " is not supported (expected " + std::to_string(kVersion) + ")");
     if (meta.at("byte_order").get<std::string>() != "little") bad(meta_file, "byte order is not little-endian");
     count = meta.at("count").get<std::size_t>();

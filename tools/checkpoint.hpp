@@ -3,9 +3,12 @@
 // that never stopped. Which fields are saved comes from the field registry (FieldDesc::checkpoint).
 //
 // Layout of a checkpoint directory:
-//   checkpoint.json   {"format":"turbid-checkpoint","version":1,"byte_order":"little","count":N,
+//   checkpoint.json   {"format":"turbid-checkpoint","version":2,"byte_order":"little","count":N,
 //                      "fields":[{"name","type","components","unit","file","bytes","fnv1a64"}...],
-//                      "state":<caller's json>}
+//                      "state":<caller's json>,
+//                      "digests":{"state","fields"}}   FNV-1a of the state block and of the field
+//                      list as written: an edit afterwards (even with a recomputed field checksum)
+//                      is refused, naming the block (version 1 files, without digests, still read)
 //   <field>.bin       count * components * sizeof(type) raw native (little-endian) bytes
 #pragma once
 #include <filesystem>

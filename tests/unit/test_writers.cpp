@@ -485,6 +485,65 @@ TEST(Checkpoint, MismatchesAreErrors) {
   }
 }
 
+// Issue #27 item 5: a checkpoint.json edited after it was written is refused, saying which block
+// changed: the state (a time changed by hand), or the field list (a field file replaced and its
+// checksum recomputed, which the per-file checksum alone lets through).
+TEST(Checkpoint, AnEditedStateOrARecomputedChecksumIsRefused) {
+  TempDir tmp("ckptedit");
+  const fs::path dir = tmp.path / "checkpoint";
+  Ids ids{};
+  turbid::tools::write_checkpoint(dir, make_store(2, 5, ids), {{"time", 0.25}, {"step", 40}});
+  const fs::path meta_file = dir / "checkpoint.json";
+  const std::string original = [&] {
+    std::ifstream in(meta_file);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  }();
+  auto refusal = [&](const std::string& meta_text) {
+    std::ofstream(meta_file, std::ios::trunc) << meta_text;
+    Ids tids{};
+    ParticleStore t = make_target(2, tids);
+    try {
+      turbid::tools::read_checkpoint(dir, t);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(refusal(original), "no error");
+  {  // the state's time edited
+    std::string edited = original;
+    const std::size_t at = edited.find("0.25");
+    ASSERT_NE(at, std::string::npos);
+    edited.replace(at, 4, "0.35");
+    const std::string m = refusal(edited);
+    EXPECT_NE(m.find("checkpoint.json"), std::string::npos) << m;
+    EXPECT_NE(m.find("the 'state' block differs"), std::string::npos) << m;
+    EXPECT_THROW(turbid::tools::read_checkpoint_state(dir), std::runtime_error);
+  }
+  {  // density.bin replaced (first byte changed) and its FNV-1a checksum recomputed in the JSON
+    std::fstream f(dir / "density.bin", std::ios::in | std::ios::out | std::ios::binary);
+    std::vector<char> bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    bytes[0] = char(bytes[0] ^ 0x55);
+    f.seekp(0);
+    f.write(bytes.data(), std::streamsize(bytes.size()));
+    f.close();
+    std::uint64_t h = 0xcbf29ce484222325ull;
+    for (char c : bytes) h = (h ^ static_cast<unsigned char>(c)) * 0x100000001b3ull;
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+    std::string edited = original;
+    const std::size_t field = edited.find("\"density.bin\"");
+    ASSERT_NE(field, std::string::npos);
+    const std::size_t sum = edited.find("\"fnv1a64\": \"", edited.rfind('{', field));
+    ASSERT_NE(sum, std::string::npos);
+    edited.replace(sum + 12, 16, hex);
+    const std::string m = refusal(edited);
+    EXPECT_NE(m.find("the 'fields' list"), std::string::npos) << m;
+  }
+}
+
 TEST(Checkpoint, ReadsOldCopyAfterACrashBetweenRenames) {
   // write_checkpoint renames dir -> dir.old before dir.tmp -> dir; a crash in between leaves dir.old.
   TempDir tmp("ckptold");
