@@ -281,6 +281,10 @@ struct NumericsSpec {
   double viscous_dt_factor = 0.125;        // dt <= factor h^2 / nu_max (Morris et al. 1997)
   double min_time_step = 1.0e-9;           // a smaller dt stops the run as collapsed [s]
   double density_ratio_limit = 0.5;        // |rho/rho0 - 1| above this stops the run [-]
+  // More fluid particles than this behind a wall or structure surface at an output stops the run
+  // (fsi/wall_penetration.hpp); unset: counted and reported only.
+  std::optional<std::uint64_t> max_fluid_behind_walls;
+  SourceLocation max_fluid_behind_walls_where;
   BoundaryKind boundary = BoundaryKind::dbc;  // wall treatment for walls and structures
   // Walls and structures show the viscous terms the fluid's velocity mirrored at their ghost nodes
   // (no-slip at the wall surface); unset: yes where a material has the full viscous stress.

@@ -1238,9 +1238,13 @@ void Simulation::build_particles() {
       // no pressure jump between fluid and wall.
       const double depth = std::isfinite(global_top) ? std::max(0.0, global_top - height_of(s, x)) : 0.0;
       Point ghost{0, 0, 0};
+      // The surface is the box as built (whole cells from its min corner, where the particles
+      // stand dx/2 behind it), not as stated: a solid box stated 0.161 m long at dx = 0.03 is built
+      // 0.15 m long, and its stated face once put the ghost nodes 0.011 m too far out.
+      const geometry::Aabb& built = wall_cells[std::size_t(&w - s.walls.data())];
       switch (w.kind) {
-        case WallSpec::Kind::container: ghost = ghost_container(w.box, x, d); break;
-        case WallSpec::Kind::solid_box: ghost = ghost_solid_box(w.box, x, d); break;
+        case WallSpec::Kind::container: ghost = ghost_container({built.min, built.max}, x, d); break;
+        case WallSpec::Kind::solid_box: ghost = ghost_solid_box({built.min, built.max}, x, d); break;
         case WallSpec::Kind::polyline: ghost = ghost_polyline(w, x, d); break;
       }
       const double rho = layered ? layered_density(wall_eos, x, true) : wall_eos.hydrostatic_density(g, depth);
@@ -1373,6 +1377,13 @@ void Simulation::build_particles() {
     kind[i] = std::uint8_t(items[i].kind);
     id[i] = std::uint32_t(i);
   }
+  // Walls and structures follow the fluid in `items` (fluid, walls, structures, buffers).
+  boundary_first_id_ = std::uint32_t(summary_.fluid_particles);
+  boundary_ghost0_.clear();
+  for (std::size_t i = boundary_first_id_; i < items.size(); ++i) {
+    if (items[i].kind != sph::Kind::wall && items[i].kind != sph::Kind::structure) break;
+    boundary_ghost0_.push_back({float(items[i].ghost[0]), float(items[i].ghost[1]), float(items[i].ghost[2])});
+  }
   summary_.smoothing_length = params_.smoothing_length;
   for (int m = 0; m < params_.material_count; ++m) summary_.sound_speed.push_back(params_.materials[m].sound_speed);
   // Store fields plus the neighbour search's keys, order and permutation scratch.
@@ -1490,6 +1501,32 @@ std::vector<BodyKinematics> Simulation::body_kinematics() const {
   return out;
 }
 
+FluidBehindWalls Simulation::measure_fluid_behind_walls() {
+  sync_to_host();
+  PenetrationInput in;
+  in.dimensions = scene_.dimensions;
+  in.size = store_.size();
+  in.position = static_cast<const float*>(store_.raw(ids_.position));
+  in.kind = store_.data<std::uint8_t>(ids_.kind);
+  in.id = store_.data<std::uint32_t>(ids_.id);
+  in.body = ids_.body >= 0 ? store_.data<std::uint8_t>(ids_.body) : nullptr;
+  in.ghost0 = &boundary_ghost0_;
+  in.first_id = boundary_first_id_;
+  in.radius = 2.0 * params_.smoothing_length;  // the kernel support
+  in.tolerance = 0.25 * scene_.particle_spacing;  // see fsi/wall_penetration.hpp
+  in.band = 0.5 * scene_.particle_spacing;
+  for (const auto& k : body_kinematics()) {
+    const Eigen::Quaterniond q(k.orientation[0], k.orientation[1], k.orientation[2], k.orientation[3]);
+    const Eigen::Matrix3d R = q.normalized().toRotationMatrix();
+    std::array<double, 9> r{};
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) r[std::size_t(3 * a + b)] = R(a, b);
+    in.rotation.push_back(r);
+  }
+  behind_walls_ = count_fluid_behind_walls(in);
+  return behind_walls_;
+}
+
 std::vector<double> Simulation::probe_values() {
   sync_to_host();
   return evaluate_probes(scene_, store_, ids_, params_);
@@ -1503,7 +1540,7 @@ void Simulation::run(Observer& observer) {
   // Output k is due at time k * every; the first step at or past that time writes it.
   auto output_due = [&] { return every > 0 ? double(output_index_) * every : 0.0; };
   if (output_index_ == 0 || time() >= output_due()) {
-    sync_to_host();
+    check_fluid_behind_walls();
     observer.on_output(*this);
     ++output_index_;
   }
@@ -1534,7 +1571,7 @@ void Simulation::run(Observer& observer) {
     const bool output_now = (every > 0 && time() >= output_due()) || last;
     if (forces_due(output_now)) write_forces();
     if (output_now) {
-      sync_to_host();
+      check_fluid_behind_walls();
       observer.on_output(*this);
       if (every > 0) output_index_ = next_index_after(time(), every, output_index_);
     }
@@ -1556,6 +1593,22 @@ void Simulation::run(Observer& observer) {
   }
   sync_to_host();
   observer.on_finish(*this);
+}
+
+// Measured at every output; past the scene's `numerics: max_fluid_behind_walls` the run stops
+// (issue #27 item 9), naming the key, the count and the deepest particle.
+void Simulation::check_fluid_behind_walls() {
+  const FluidBehindWalls& b = measure_fluid_behind_walls();
+  const auto& limit = scene_.numerics.max_fluid_behind_walls;
+  if (!limit || b.count <= *limit) return;
+  std::ostringstream os;
+  os << at_text(scene_.numerics.max_fluid_behind_walls_where, "error") << "at t = " << time() << " s, "
+     << b.count << " fluid particles are behind a wall or structure surface (" << b.below_walls << " walls, "
+     << b.inside_structures << " structures; the deepest " << b.deepest / scene_.particle_spacing
+     << " particle spacings behind), more than 'max_fluid_behind_walls' = " << *limit
+     << " allows: the walls let fluid through (a finer spacing, more wall layers or a smaller time step "
+        "may help), or raise the limit";
+  throw std::runtime_error(os.str());
 }
 
 // The smallest k >= from with k * every > time: the index of the next output, force row or

@@ -1,6 +1,7 @@
 // The Simulation: builds the particle world from a Scene, composes the fluid solver the scene
 // needs, runs the time loop and hands results to observers (writers registered by tools/).
 #pragma once
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -11,6 +12,7 @@
 #include "fsi/mass_properties.hpp"
 #include "fsi/prescribed_coupling.hpp"
 #include "fsi/scene.hpp"
+#include "fsi/wall_penetration.hpp"
 #include "sph/backend.hpp"
 #include "sph/fields.hpp"
 #include "sph/particle_store.hpp"
@@ -165,9 +167,14 @@ class Simulation {
   const PrescribedCoupling* prescribed() const { return prescribed_.get(); }
   std::uint64_t forces_index() const { return forces_index_; }
   void sync_to_host() { solver_->backend().sync_to_host(); }
+  // Fluid particles behind a wall or structure surface now (fsi/wall_penetration.hpp; synchronises
+  // the store). run() measures it at every output; the last measurement is fluid_behind_walls().
+  FluidBehindWalls measure_fluid_behind_walls();
+  const FluidBehindWalls& fluid_behind_walls() const { return behind_walls_; }
 
  private:
   void build_particles();
+  void check_fluid_behind_walls();
 
   Scene scene_;
   sph::PhysicsParams params_;
@@ -187,6 +194,11 @@ class Simulation {
   std::uint64_t forces_index_ = 0;
   std::uint64_t particle_steps_ = 0;
   bool interrupted_ = false;
+  // Ghost offsets at t = 0 of the wall and structure particles (ids from boundary_first_id_ on):
+  // the surfaces the count of fluid behind walls measures against.
+  std::vector<std::array<float, 3>> boundary_ghost0_;
+  std::uint32_t boundary_first_id_ = 0;
+  FluidBehindWalls behind_walls_;
 };
 
 // The smallest k >= from with k * every > time [s]: the index of the next entry of a periodic

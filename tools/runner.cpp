@@ -38,6 +38,11 @@ std::string format_duration(double s) {
   return buf;
 }
 
+// The progress line names fluid behind walls only when there is some (the last output's count).
+std::string behind_text(std::size_t count) {
+  return count == 0 ? std::string() : " | " + std::to_string(count) + " behind walls";
+}
+
 double fluid_mass(const fsi::Simulation& sim) {
   const auto& s = sim.store();
   const auto* m = s.data<float>(sim.fields().mass);
@@ -308,6 +313,18 @@ class Writers final : public fsi::Observer {
   }
 
   void on_output(fsi::Simulation& sim) override {
+    // Fluid behind walls: said once when first seen (and whenever it grows past twice what was
+    // said), whatever the progress setting; the scene's max_fluid_behind_walls stops the run.
+    const auto& behind = sim.fluid_behind_walls();
+    most_behind_ = std::max(most_behind_, behind.count);
+    if (behind.count > 0 && behind.count > 2 * behind_told_) {
+      std::fprintf(stderr, "%swarning: t = %.4g s: %zu fluid particles behind a wall or structure surface "
+                   "(%zu walls, %zu structures; the deepest %.2g spacings); set numerics: "
+                   "max_fluid_behind_walls to stop the run past a count\n", tty_ && progress_ ? "\n" : "",
+                   sim.time(), behind.count, behind.below_walls, behind.inside_structures,
+                   behind.deepest / sim.scene().particle_spacing);
+      behind_told_ = behind.count;
+    }
     const auto values = sim.probe_values();
     probes_->append(sim.time(), values);
     if (vtk_) vtk_->write(sim.store(), sim.time());
@@ -341,9 +358,10 @@ class Writers final : public fsi::Observer {
     const double left = std::max(0.0, sim.end_time() - sim.time());
     const double eta = left == 0 ? 0.0 : done > 0 ? elapsed * left / done : NAN;
     char line[256];
-    std::snprintf(line, sizeof line, "t = %.4g / %.4g s (%3.0f%%) | step %llu | dt %.2e s | %.3g particle-steps/s | ETA %s",
+    std::snprintf(line, sizeof line, "t = %.4g / %.4g s (%3.0f%%) | step %llu | dt %.2e s | %.3g particle-steps/s | ETA %s%s",
                   sim.time(), sim.end_time(), 100 * frac, static_cast<unsigned long long>(sim.steps()),
-                  sim.last_time_step(), rate, format_duration(eta).c_str());
+                  sim.last_time_step(), rate, format_duration(eta).c_str(),
+                  behind_text(sim.fluid_behind_walls().count).c_str());
     if (tty_) {
       std::fprintf(stderr, "\r%-110s", line);
     } else if (sim.wall_seconds() - last_plain_ >= 10.0 || sim.time() >= sim.end_time()) {
@@ -387,6 +405,7 @@ class Writers final : public fsi::Observer {
   }
 
   void set_inputs(nlohmann::json inputs) { inputs_ = std::move(inputs); }
+  std::size_t most_behind_walls() const { return most_behind_; }
 
   void start_clock(const fsi::Simulation& sim) {
     wall_at_start_ = sim.wall_seconds();
@@ -398,6 +417,8 @@ class Writers final : public fsi::Observer {
   fs::path out_;
   bool progress_;
   bool tty_;
+  std::size_t most_behind_ = 0;
+  std::size_t behind_told_ = 0;
   double last_plain_ = 0;
   std::size_t refused_told_ = 0;  // splits refused that a warning has reported
   double wall_at_start_ = 0, time_at_start_ = 0;
@@ -854,6 +875,11 @@ nlohmann::json run_scene(const RunRequest& request) {
   report["particles"] = initial_particles;
   report["particles_end"] = sim.store().size();
   report["removed_particles"] = sim.removed();
+  // Fluid behind a wall or structure surface at the last output (fsi/wall_penetration.hpp), and
+  // the most seen at any output of this process.
+  report["fluid_behind_walls"] = sim.fluid_behind_walls().count;
+  report["fluid_behind_walls_deepest_m"] = sim.fluid_behind_walls().deepest;
+  report["fluid_behind_walls_max"] = writers.most_behind_walls();
   if (!scene.open_boundaries.empty()) {
     report["buffer_particles"] = sim.summary().buffer_particles;
     report["inflow_particles"] = sim.inflow();

@@ -260,6 +260,18 @@ output: {every: 0.01}
   std::ofstream(meta) << edited.dump(2);
   try {
     turbid::tools::run_scene(r);
+    ADD_FAILURE() << "an edited state resumed";
+  } catch (const std::runtime_error& e) {
+    // The state's digest sees the edit first (tools/checkpoint.hpp).
+    EXPECT_NE(std::string(e.what()).find("checkpoint.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("the 'state' block differs"), std::string::npos) << e.what();
+  }
+  // A version 1 checkpoint (no digests) with the same edit: the wrong type is named with its key.
+  edited["version"] = 1;
+  edited.erase("digests");
+  std::ofstream(meta) << edited.dump(2);
+  try {
+    turbid::tools::run_scene(r);
     ADD_FAILURE() << "a string time resumed";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("checkpoint.json"), std::string::npos) << e.what();

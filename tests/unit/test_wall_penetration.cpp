@@ -1,0 +1,197 @@
+// Fluid behind walls (issue #27 item 9; fsi/wall_penetration.hpp): a fluid particle counts when its
+// signed distance to the surface of its nearest wall or structure particle is negative. Reference:
+// the geometry of each case (a floor whose surface is z = 0 with its particles dx/2 and 3dx/2 below,
+// a structure particle turned by a stated rotation); a tank at rest has none behind its walls.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "fsi/simulation.hpp"
+#include "fsi/wall_penetration.hpp"
+#include "sph/physics_params.hpp"
+#include "tests/unit/body_test_support.hpp"
+
+namespace {
+
+using namespace turbid;
+using sph::Kind;
+
+struct Layout {
+  std::vector<float> x;
+  std::vector<std::uint8_t> kind, body;
+  std::vector<std::uint32_t> id;
+  std::vector<std::array<float, 3>> ghost0;
+  void boundary(float px, float py, std::array<float, 3> g, Kind k = Kind::wall, std::uint8_t b = 0) {
+    x.push_back(px), x.push_back(py);
+    kind.push_back(std::uint8_t(k)), body.push_back(b);
+    id.push_back(std::uint32_t(100 + ghost0.size()));
+    ghost0.push_back(g);
+  }
+  void fluid(float px, float py) {
+    x.push_back(px), x.push_back(py);
+    kind.push_back(std::uint8_t(Kind::fluid)), body.push_back(255);
+    id.push_back(std::uint32_t(1000 + kind.size()));
+  }
+  fsi::PenetrationInput input(double radius) const {
+    fsi::PenetrationInput in;
+    in.dimensions = 2;
+    in.size = kind.size();
+    in.position = x.data();
+    in.kind = kind.data();
+    in.id = id.data();
+    in.body = body.data();
+    in.ghost0 = &ghost0;
+    in.first_id = 100;
+    in.radius = radius;
+    return in;
+  }
+};
+
+TEST(FluidBehindWalls, CountsWhatIsBeyondTheFloorSurfaceAndHowDeep) {
+  const float dx = 0.01f;
+  Layout L;
+  // A floor with its surface at y = 0: two layers, ghosts 2 x depth along +y.
+  for (int i = -5; i <= 15; ++i) {
+    L.boundary(i * dx, -0.5f * dx, {0, dx, 0});
+    L.boundary(i * dx, -1.5f * dx, {0, 3 * dx, 0});
+  }
+  for (int i = 0; i < 10; ++i) L.fluid(i * dx, 0.5f * dx);  // the lattice's first row: dx/2 in front
+  L.fluid(0.03f, 0.05f * dx);                              // in front, close: not behind
+  L.fluid(0.04f, -0.2f * dx);                              // 0.2 dx behind: within a tolerance of dx/4
+  L.fluid(0.05f, -0.3f * dx);                              // 0.3 dx behind
+  L.fluid(0.07f, -1.2f * dx);                              // 1.2 dx behind, among the layers
+  auto in = L.input(2 * dx);
+  auto b = fsi::count_fluid_behind_walls(in);
+  EXPECT_EQ(b.count, 3u);
+  EXPECT_EQ(b.below_walls, 3u);
+  EXPECT_EQ(b.inside_structures, 0u);
+  EXPECT_NEAR(b.deepest, 1.2 * dx, 1e-6);
+  in.tolerance = 0.25 * dx;
+  b = fsi::count_fluid_behind_walls(in);
+  EXPECT_EQ(b.count, 2u);
+}
+
+TEST(FluidBehindWalls, AStructuresSurfaceTurnsWithItsBody) {
+  const float dx = 0.01f;
+  Layout L;
+  // One structure particle at the origin whose ghost at t = 0 pointed along +x; its body has since
+  // turned by +90 degrees about z, so its surface normal is +y and its surface is y = dx/2.
+  L.boundary(0, 0, {dx, 0, 0}, Kind::structure, 0);
+  L.fluid(0.4f * dx, 0.3f * dx);   // behind the turned surface (0.2 dx), though in front of the old one
+  auto in = L.input(2 * dx);
+  in.rotation = {{0, -1, 0, 1, 0, 0, 0, 0, 1}};
+  auto b = fsi::count_fluid_behind_walls(in);
+  EXPECT_EQ(b.count, 1u);
+  EXPECT_EQ(b.inside_structures, 1u);
+  EXPECT_NEAR(b.deepest, 0.2 * dx, 1e-6);
+  in.rotation = {{1, 0, 0, 0, 1, 0, 0, 0, 1}};  // not turned: x = 0.4 dx is 0.1 dx behind x = dx/2
+  b = fsi::count_fluid_behind_walls(in);
+  EXPECT_EQ(b.count, 1u);
+  EXPECT_NEAR(b.deepest, 0.1 * dx, 1e-6);
+}
+
+// The corner of a 2D solid box (x < 0, y < 0; 4 x 4 particles, each ghost along the normal of its
+// nearest face, the corner particle's along +y): fluid beside its right face, below the top
+// surface's height, is in front of the box; fluid inside near the corner is behind both faces, by
+// its distance to the nearer one.
+TEST(FluidBehindWalls, BesideABoxsEdgeIsNotBehindItsTopFace) {
+  const float dx = 0.01f;
+  Layout L;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {
+      const float x = -(i + 0.5f) * dx, y = -(j + 0.5f) * dx;
+      const bool top = j <= i;  // the top face (y = 0) is nearest, or ties on the diagonal
+      L.boundary(x, y, top ? std::array<float, 3>{0, 2 * -y, 0} : std::array<float, 3>{2 * -x, 0, 0});
+    }
+  L.fluid(0.3f * dx, -1.0f * dx);   // beside the right face (x = 0), 0.3 dx in front of it
+  L.fluid(-0.2f * dx, -0.8f * dx);  // inside: 0.2 dx behind the right face, 0.8 dx below the top
+  auto in = L.input(2 * dx);
+  in.band = 0.5 * dx;
+  const auto b = fsi::count_fluid_behind_walls(in);
+  EXPECT_EQ(b.count, 1u);
+  EXPECT_NEAR(b.deepest, 0.2 * dx, 1e-6);
+}
+
+TEST(FluidBehindWalls, NothingBeyondTheSearchRadiusCounts) {
+  const float dx = 0.01f;
+  Layout L;
+  L.boundary(0, 0, {0, dx, 0});
+  L.fluid(0, -3 * dx);  // behind the plane, but no boundary particle within 2 dx
+  EXPECT_EQ(fsi::count_fluid_behind_walls(L.input(2 * dx)).count, 0u);
+  EXPECT_EQ(fsi::count_fluid_behind_walls(L.input(4 * dx)).count, 1u);
+}
+
+// A 2D tank at rest, built by fsi::Simulation with DBC and with mDBC walls: the lattice leaves every
+// fluid particle dx/2 in front of the walls' surfaces, so none is behind.
+TEST(FluidBehindWalls, ATankAtRestHasNoneBehindItsWalls) {
+  for (const char* boundary : {"dbc", "mdbc"}) {
+    const std::string yaml = std::string(R"(name: tank
+dimensions: 2
+resolution: {particle_spacing: 0.02, smoothing_ratio: 2.0}
+time: {end: 0.01}
+numerics: {boundary: {type: )") + boundary + R"(}}
+materials:
+  water: {density: 1000, sound_speed: 20}
+walls:
+  - box: {min: [0, 0], max: [1.0, 0.6]}
+fluids:
+  - {material: water, box: {min: [0, 0], max: [1.0, 0.3]}}
+)";
+    fsi::Simulation sim(test::scene_of(yaml), test::cpu());
+    const auto b = sim.measure_fluid_behind_walls();
+    EXPECT_EQ(b.count, 0u) << boundary;
+  }
+}
+
+// The scene's limit stops the run at the output that finds more behind walls than it allows, with
+// the key's line and the count; within the limit the run goes on.
+TEST(FluidBehindWalls, MoreThanTheScenesLimitStopsTheRunAtItsLine) {
+  for (int limit : {0, 1}) {
+    const std::string yaml = R"(name: tank
+dimensions: 2
+resolution: {particle_spacing: 0.02, smoothing_ratio: 2.0}
+time: {end: 0.002}
+numerics:
+  max_fluid_behind_walls: )" + std::to_string(limit) + R"(
+materials:
+  water: {density: 1000, sound_speed: 20}
+walls:
+  - box: {min: [0, 0], max: [1.0, 0.6]}
+fluids:
+  - {material: water, box: {min: [0, 0], max: [1.0, 0.3]}}
+output: {every: 0.001, vtk: false}
+)";
+    fsi::Simulation sim(test::scene_of(yaml), test::cpu());
+    sim.start();
+    // Put one fluid particle of the bottom row 0.3 dx below the floor's surface (y = 0), past the
+    // count's tolerance of dx/4.
+    auto& st = sim.store();
+    auto* x = static_cast<float*>(st.raw(sim.fields().position));
+    const auto* kind = st.data<std::uint8_t>(sim.fields().kind);
+    for (std::size_t i = 0; i < st.size(); ++i)
+      if (kind[i] == std::uint8_t(Kind::fluid) && x[2 * i + 1] < 0.011f && x[2 * i] > 0.4f) {
+        x[2 * i + 1] = -0.006f;
+        break;
+      }
+    fsi::Observer quiet;
+    if (limit == 0) {
+      try {
+        sim.run(quiet);
+        ADD_FAILURE() << "the run went on with fluid behind the floor";
+      } catch (const std::runtime_error& e) {
+        const std::string m = e.what();
+        EXPECT_EQ(m.rfind("test.yaml:6:", 0), 0u) << m;
+        EXPECT_NE(m.find("1 fluid particles are behind"), std::string::npos) << m;
+        EXPECT_NE(m.find("max_fluid_behind_walls"), std::string::npos) << m;
+      }
+    } else {
+      EXPECT_NO_THROW(sim.run(quiet));
+      EXPECT_LE(sim.fluid_behind_walls().count, 1u);
+    }
+  }
+}
+
+}  // namespace
