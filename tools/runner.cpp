@@ -38,6 +38,13 @@ std::string format_duration(double s) {
   return buf;
 }
 
+// A number with `digits` significant digits, for what `turbid check` prints (0.6754, not 0.675400013).
+std::string sig(double v, int digits = 4) {
+  std::ostringstream o;
+  o << std::setprecision(digits) << v;
+  return o.str();
+}
+
 // The progress line names fluid behind walls only when there is some (the last output's count).
 std::string behind_text(std::size_t count) {
   return count == 0 ? std::string() : " | " + std::to_string(count) + " behind walls";
@@ -569,7 +576,7 @@ std::string describe_scene(const fsi::Scene& scene) {
     os << "  " << (ob.inlet ? "inlet " : "outlet ") << ob.name << ": flow along "
        << (ob.velocity.sign > 0 ? "+" : "-") << "xyz"[ob.velocity.axis]
        << (ob.inlet ? (ob.velocity.parabolic ? ", parabolic profile, mean " : ", uniform ") : "")
-       << (ob.inlet ? std::to_string(ob.velocity.mean) + " m/s" : std::string(", pressure = background pressure"))
+       << (ob.inlet ? sig(ob.velocity.mean) + " m/s" : std::string(", pressure = background pressure"))
        << "\n";
   if (s.fluid_removed_by_structures > 0)
     os << "  fluid lattice points left out inside structures: " << s.fluid_removed_by_structures
@@ -584,16 +591,18 @@ std::string describe_scene(const fsi::Scene& scene) {
   for (const auto& e : s.extents) {
     os << "  " << e.what << " (line " << e.where.line << "):";
     for (int k = 0; k < scene.dimensions; ++k) {
-      os << " " << "xyz"[k] << " " << e.stated.min[k] << " to " << e.stated.max[k];
+      os << " " << "xyz"[k] << " " << sig(e.stated.min[k], 6) << " to " << sig(e.stated.max[k], 6);
       const double tol = 1e-6 * scene.particle_spacing;
       if (std::abs(e.built.min[k] - e.stated.min[k]) > tol || std::abs(e.built.max[k] - e.stated.max[k]) > tol)
-        os << " (built " << e.built.min[k] << " to " << e.built.max[k] << ")";
+        os << " (built " << sig(e.built.min[k], 6) << " to " << sig(e.built.max[k], 6) << ")";
       os << ",";
     }
-    os << " " << (e.what == "container" ? "inside " : "") << "volume " << e.stated_volume;
-    if (std::abs(e.built_volume - e.stated_volume) > 1e-6 * e.stated_volume)
-      os << " (built " << e.built_volume << ", " << std::showpos << 100 * (e.built_volume / e.stated_volume - 1)
-         << std::noshowpos << "%)";
+    os << " " << (e.what == "container" ? "inside " : "") << "volume " << sig(e.stated_volume);
+    if (std::abs(e.built_volume - e.stated_volume) > 1e-6 * e.stated_volume) {
+      char pct[32];
+      std::snprintf(pct, sizeof pct, "%+.1f%%", 100 * (e.built_volume / e.stated_volume - 1));
+      os << " (built " << sig(e.built_volume) << ", " << pct << ")";
+    }
     os << (two_d ? " m^2\n" : " m^3\n");
   }
   const sph::PhysicsParams params = fsi::physics_params(scene);
@@ -613,8 +622,8 @@ std::string describe_scene(const fsi::Scene& scene) {
       continue;
     }
     os << " (yield stress " << mat.yield_stress << " Pa, "
-       << (mat.model == "bingham" ? "plastic viscosity " + std::to_string(mat.viscosity) + " Pa s"
-                                  : "K " + std::to_string(mat.consistency) + " Pa s^n, n " + std::to_string(mat.flow_index))
+       << (mat.model == "bingham" ? "plastic viscosity " + sig(mat.viscosity) + " Pa s"
+                                  : "K " + sig(mat.consistency) + " Pa s^n, n " + sig(mat.flow_index))
        << ", m " << mat.papanastasiou_exponent << " s), ";
     const double bound = params.materials[m].rheology.bound();
     if (mat.max_viscosity > 0) os << "effective viscosity capped at " << mat.max_viscosity << " Pa s (stated)";
@@ -635,7 +644,7 @@ std::string describe_scene(const fsi::Scene& scene) {
        << " daughters (h/2), up to " << t.levels << (t.levels == 1 ? " level" : " levels") << "\n";
   const std::size_t capacity = fsi::particle_capacity(scene, total);
   const double mib = double(capacity) * double(s.bytes_per_particle) / (1024.0 * 1024.0);
-  os << "memory           " << s.bytes_per_particle << " bytes/particle, about " << mib << " MiB";
+  os << "memory           " << s.bytes_per_particle << " bytes/particle, about " << sig(mib, 3) << " MiB";
   if (capacity > total)
     os << " for the " << capacity << " particles reserved (" << (capacity - total) << " for daughters; on_full: "
        << (scene.capacity.error_when_full ? "error" : "warn") << ")";

@@ -15,7 +15,8 @@ TYPES = {"Float32": np.float32, "Float64": np.float64, "UInt8": np.uint8, "Int32
 
 
 def read_vtp(path):
-    """{array name: numpy array} of one frame; positions are under 'Points' (n x 3)."""
+    """{array name: numpy array} of one frame; positions are under 'Points' (n x 3), and
+    'units' maps field names to their units ({} when the frame has none)."""
     raw = pathlib.Path(path).read_bytes()
     marker = raw.index(b"<AppendedData")
     start = raw.index(b"_", marker) + 1
@@ -23,18 +24,32 @@ def read_vtp(path):
     if 'header_type="UInt64"' not in header or "vtkZLibDataCompressor" not in header:
         sys.exit(f"{path}: expected zlib-compressed appended data with UInt64 headers (turbid's format)")
     arrays = {}
+
+    def block(attrs):
+        pos = start + int(attrs["offset"])
+        nblocks = struct.unpack_from("<Q", raw, pos)[0]
+        sizes = struct.unpack_from(f"<{3 + nblocks}Q", raw, pos)
+        data, p = b"", pos + 8 * (3 + nblocks)
+        for c in sizes[3:]:
+            data += zlib.decompress(raw[p:p + c])
+            p += c
+        return data
+
+    # The field data's string array "units" ("pressure [Pa]", ...): arrays["units"] = {name: unit}.
+    for m in re.finditer(r'<Array ([^>]*?)/?>', header):
+        attrs = dict(re.findall(r'(\w+)="([^"]*)"', m.group(1)))
+        if attrs.get("type") == "String" and attrs.get("Name") == "units" and attrs.get("format") == "appended":
+            units = {}
+            for entry in block(attrs).split(b"\0"):
+                um = re.match(r"(.*) \[(.*)\]$", entry.decode("utf-8", "replace"))
+                if um:
+                    units[um.group(1)] = um.group(2)
+            arrays["units"] = units
     for m in re.finditer(r'<DataArray ([^>]*?)/?>', header):
         attrs = dict(re.findall(r'(\w+)="([^"]*)"', m.group(1)))
         if attrs.get("format") != "appended" or attrs.get("type") not in TYPES:
             continue
-        pos = start + int(attrs["offset"])
-        nblocks = struct.unpack_from("<Q", raw, pos)[0]
-        sizes = struct.unpack_from(f"<{3 + nblocks}Q", raw, pos)
-        comp = sizes[3:]
-        data, p = b"", pos + 8 * (3 + nblocks)
-        for c in comp:
-            data += zlib.decompress(raw[p:p + c])
-            p += c
+        data = block(attrs)
         values = np.frombuffer(data, dtype=TYPES[attrs["type"]])
         ncomp = int(attrs.get("NumberOfComponents", "1"))
         name = attrs.get("Name", "points")
