@@ -135,6 +135,10 @@ class Simulation {
   void restore_split_totals(const sph::SplitCounts& c) { solver_->restore_split_totals(c); }
   double wall_seconds() const { return wall_seconds_; }
   double particle_steps_per_second() const;
+  // Steps times fluid particles (not walls, structures or buffers), per second of wall time.
+  double fluid_particle_steps_per_second() const;
+  std::uint64_t fluid_particle_steps() const { return fluid_particle_steps_; }
+  void restore_fluid_particle_steps(std::uint64_t n) { fluid_particle_steps_ = n; }
 
   // Output bookkeeping, saved in checkpoints so a resumed run writes the same frames.
   std::uint64_t output_index() const { return output_index_; }
@@ -193,6 +197,7 @@ class Simulation {
   std::uint64_t checkpoint_index_ = 0;
   std::uint64_t forces_index_ = 0;
   std::uint64_t particle_steps_ = 0;
+  std::uint64_t fluid_particle_steps_ = 0;
   bool interrupted_ = false;
   // Ghost offsets at t = 0 of the wall and structure particles (ids from boundary_first_id_ on):
   // the surfaces the count of fluid behind walls measures against.

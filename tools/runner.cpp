@@ -199,7 +199,8 @@ void check_run_state(const nlohmann::json& state, const fs::path& file) {
                       {"particle_spacing", true, false}, {"end_time", true, false},      {"wall_seconds", false, false},
                       {"inflow", false, true},         {"outflow", false, true},        {"splits", false, true},
                       {"daughters", false, true},      {"splits_refused", false, true},
-                      {"smallest_smoothing_length", false, false}, {"checkpoint_every", false, false}};
+                      {"smallest_smoothing_length", false, false}, {"checkpoint_every", false, false},
+                      {"fluid_particle_steps", false, true}};
   for (const Key& k : keys) {
     if (!state.contains(k.name)) {
       if (k.required) bad(file, "'state' has no '" + std::string(k.name) + "'");
@@ -390,6 +391,7 @@ class Writers final : public fsi::Observer {
     state["output_index"] = sim.output_index();
     state["checkpoint_index"] = sim.checkpoint_index();
     state["particle_steps"] = sim.particle_steps();
+    state["fluid_particle_steps"] = sim.fluid_particle_steps();
     state["inflow"] = sim.inflow();
     state["outflow"] = sim.outflow();
     if (!sim.scene().transitions.empty()) {
@@ -824,6 +826,7 @@ nlohmann::json run_scene(const RunRequest& request) {
   report["git_revision"] = TURBID_GIT_REVISION;
   report["version"] = TURBID_VERSION;
   report["units"] = {{"simulated_time", "s"}, {"wall_seconds", "s"}, {"particle_steps_per_second", "1/s"},
+                     {"fluid_particle_steps_per_second", "1/s"}, {"fluid_behind_walls_deepest_m", "m"},
                      {"fluid_mass", scene.dimensions == 2 ? "kg/m" : "kg"},
                      {"mass_start", scene.dimensions == 2 ? "kg/m" : "kg"},
                      {"mass_end", scene.dimensions == 2 ? "kg/m" : "kg"},
@@ -844,6 +847,7 @@ nlohmann::json run_scene(const RunRequest& request) {
                  state.at("checkpoint_index").get<std::uint64_t>(), state.at("particle_steps").get<std::uint64_t>(),
                  state.value("wall_seconds", 0.0));
       sim.restore_open_boundary_counts(state.value("inflow", std::uint64_t(0)), state.value("outflow", std::uint64_t(0)));
+      sim.restore_fluid_particle_steps(state.value("fluid_particle_steps", std::uint64_t(0)));
       sph::SplitCounts splits;
       splits.splits = state.value("splits", std::size_t(0));
       splits.daughters = state.value("daughters", std::size_t(0));
@@ -919,6 +923,9 @@ nlohmann::json run_scene(const RunRequest& request) {
   report["simulated_time"] = sim.time();
   report["wall_seconds"] = sim.wall_seconds();
   report["particle_steps_per_second"] = sim.particle_steps_per_second();
+  // The same with fluid particles only (walls, structures and buffers left out): what a scene's
+  // fluid costs, comparable between scenes whose walls differ (issue #24 item 3).
+  report["fluid_particle_steps_per_second"] = sim.fluid_particle_steps_per_second();
   if (request.resume) {
     // The whole run's figures above count the segments before the checkpoint too (their wall time
     // is stored in it); this segment's own, this process only:
