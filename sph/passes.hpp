@@ -599,18 +599,6 @@ TURBID_HD inline bool central_stress_pair(const MaterialParams& Mi, const Materi
   return Mi.central_stress || (fluid_j && Mj.central_stress);
 }
 
-// The fluid pressure p_i that the pressure term -(p_i + p_b) / (rho_i rho_b) of a fluid particle and
-// a wall or structure particle uses. A fluid particle in tension (p_i < 0: a splash pulling apart)
-// that approaches the wall (v_ib . r_ib < 0) counts as at zero pressure: the wall does not draw it
-// in further, just as the walls' own pressure is never below zero (TaitEos::no_tension_density).
-// Fluid leaving the wall keeps its tension, which holds a film to the wall as the ambient pressure
-// would (without it, fluid leaving a wall kept the continuity density of a particle that had lost
-// the wall's half of its support, and fell to half the rest density). Films drawn into the floor and
-// the box of a 3D dam break were fluid found behind walls (issue #27 item 9).
-TURBID_HD inline Real wall_pressure_of_fluid(Real p_i, Real vib_dot_rib) {
-  return p_i < Real(0) && vib_dot_rib < Real(0) ? Real(0) : p_i;
-}
-
 // Acceleration of fluid particle i (velocity vi, density rho_i, pressure p_i, smoothing length
 // h_i, material Mi, viscosity mu_i) due to particle j at r_ij = x_i - x_j: pressure and viscosity
 // (physics.md C10, C2). Boundary particles take the fluid's viscosity mu_i (no-slip in the fluid's
@@ -629,10 +617,7 @@ TURBID_HD inline Vec<D> momentum_pair(const ParticleView<D>& P, const PhysicsPar
   const MaterialParams& Mj = prm.materials[mat_j];
   const Vec<D> vij = vi - viscous_velocity_of<D>(P, j);
   const Real eta2 = kEta2Factor * h * h;
-  // A wall does not draw approaching fluid into itself (wall_pressure_of_fluid).
-  const bool boundary_j = P.kind[j] == std::uint8_t(Kind::wall) || P.kind[j] == std::uint8_t(Kind::structure);
-  const Real p_pair = boundary_j ? wall_pressure_of_fluid(p_i, dot(vi - P.velocity[j], rij)) : p_i;
-  Real s = pair::pressure(m_j, p_pair, P.pressure[j], rho_i, rho_j, F);
+  Real s = pair::pressure(m_j, p_i, P.pressure[j], rho_i, rho_j, F);
   if (prm.viscosity == Viscosity::artificial) {
     s += pair::artificial_viscosity(prm.artificial_viscosity, h, Real(0.5) * (Mi.sound_speed + Mj.sound_speed),
                                     Real(0.5) * (rho_i + rho_j), m_j, dot(vij, rij), r2, eta2, F);
@@ -745,7 +730,6 @@ struct MomentumPass {
     });
     if (!fits) return false;
     const std::uint32_t padded = (m + W - 1) / W * W;
-    // p_j holds the pair's pressure sum p_i + p_j.
     alignas(32) Real rho_j[kMaxNeighbours + W], p_j[kMaxNeighbours + W], m_j[kMaxNeighbours + W],
         c_j[kMaxNeighbours + W];
     const Real c_i = Mi.sound_speed;
@@ -757,9 +741,7 @@ struct MomentumPass {
       if (!valid) g.set_pad(k, h);
       g.set_vr(k, P, vi, j);
       rho_j[k] = P.density[j];
-      // p_i + p_j; against a boundary particle as momentum_pair takes it (wall_pressure_of_fluid).
-      const bool boundary_j = P.kind[j] == std::uint8_t(Kind::wall) || P.kind[j] == std::uint8_t(Kind::structure);
-      p_j[k] = (boundary_j ? wall_pressure_of_fluid(p_i, g.vr[k]) : p_i) + P.pressure[j];
+      p_j[k] = P.pressure[j];
       m_j[k] = valid ? P.mass[j] : Real(0);
       c_j[k] = one_c ? c_i
                      : prm.materials[P.kind[j] == std::uint8_t(Kind::fluid) ? int(P.material[j]) : prm.wall_material]
@@ -775,7 +757,7 @@ struct MomentumPass {
         const Real r2 = g.r2(k);
         const Real F = K::f_inv(std::sqrt(r2), inv_h);
         const Real c_mean = Real(0.5) * (c_i + c_j[k]);
-        const Real press = -p_j[k] / (rho_i * rho_j[k]);
+        const Real press = -(p_i + p_j[k]) / (rho_i * rho_j[k]);
         const Real vr = g.vr[k];
         const Real visc_full = ah * c_mean * vr / ((r2 + eta2) * Real(0.5) * (rho_i + rho_j[k]));
         const Real visc = vr < Real(0) ? visc_full : Real(0);

@@ -200,16 +200,13 @@ namespace {
 
 // A cylinder of radius 0.05 m oscillating across a 0.4 x 0.3 m tank of still water (no gravity:
 // the fluid is at rest until the cylinder moves it), and turning as it goes.
-// A closed tank without gravity: the water needs an ambient (background) pressure, else the
-// cylinder's wake is below zero absolute pressure and, since walls do not pull (momentum_pair), opens
-// a cavity in the first 0.1 s.
 const char* kOscillatingScene = R"(name: prescribed_check
 dimensions: 2
 resolution: {particle_spacing: 0.01, smoothing_ratio: 2.0}
 time: {end: 0.1, cfl: 0.2}
 gravity: [0, 0]
 materials:
-  water: {density: 1000, viscosity: 1.0e-3, sound_speed: 10, background_pressure: 5000}
+  water: {density: 1000, viscosity: 1.0e-3, sound_speed: 10}
 walls:
   - box: {min: [0, 0], max: [0.4, 0.3]}
 fluids:
