@@ -124,22 +124,27 @@ TEST(FluidBehindWalls, NothingBeyondTheSearchRadiusCounts) {
   EXPECT_EQ(fsi::count_fluid_behind_walls(L.input(4 * dx)).count, 1u);
 }
 
-// A 2D tank at rest, built by fsi::Simulation with DBC and with mDBC walls: the lattice leaves every
-// fluid particle dx/2 in front of the walls' surfaces, so none is behind.
-TEST(FluidBehindWalls, ATankAtRestHasNoneBehindItsWalls) {
-  for (const char* boundary : {"dbc", "mdbc"}) {
-    const std::string yaml = std::string(R"(name: tank
+// A 2D tank 1 x 0.6 m at dx = 0.02 m, water 0.3 m deep; `numerics` (YAML lines) and `rest` follow.
+std::string tank(const std::string& numerics, const std::string& rest) {
+  return R"(name: tank
 dimensions: 2
 resolution: {particle_spacing: 0.02, smoothing_ratio: 2.0}
-time: {end: 0.01}
-numerics: {boundary: {type: )") + boundary + R"(}}
+numerics:
+)" + numerics + R"(
 materials:
   water: {density: 1000, sound_speed: 20}
 walls:
   - box: {min: [0, 0], max: [1.0, 0.6]}
 fluids:
   - {material: water, box: {min: [0, 0], max: [1.0, 0.3]}}
-)";
+)" + rest;
+}
+
+// A 2D tank at rest, built by fsi::Simulation with DBC and with mDBC walls: the lattice leaves every
+// fluid particle dx/2 in front of the walls' surfaces, so none is behind.
+TEST(FluidBehindWalls, ATankAtRestHasNoneBehindItsWalls) {
+  for (const char* boundary : {"dbc", "mdbc"}) {
+    const std::string yaml = tank(std::string("  boundary: {type: ") + boundary + "}", "time: {end: 0.01}\n");
     fsi::Simulation sim(test::scene_of(yaml), test::cpu());
     const auto b = sim.measure_fluid_behind_walls();
     EXPECT_EQ(b.count, 0u) << boundary;
@@ -150,20 +155,8 @@ fluids:
 // the key's line and the count; within the limit the run goes on.
 TEST(FluidBehindWalls, MoreThanTheScenesLimitStopsTheRunAtItsLine) {
   for (int limit : {0, 1}) {
-    const std::string yaml = R"(name: tank
-dimensions: 2
-resolution: {particle_spacing: 0.02, smoothing_ratio: 2.0}
-time: {end: 0.002}
-numerics:
-  max_fluid_behind_walls: )" + std::to_string(limit) + R"(
-materials:
-  water: {density: 1000, sound_speed: 20}
-walls:
-  - box: {min: [0, 0], max: [1.0, 0.6]}
-fluids:
-  - {material: water, box: {min: [0, 0], max: [1.0, 0.3]}}
-output: {every: 0.001, vtk: false}
-)";
+    const std::string yaml =
+        tank("  max_fluid_behind_walls: " + std::to_string(limit), "time: {end: 0.002}\noutput: {every: 0.001, vtk: false}\n");
     fsi::Simulation sim(test::scene_of(yaml), test::cpu());
     sim.start();
     // Put one fluid particle of the bottom row 0.3 dx below the floor's surface (y = 0), past the
@@ -183,7 +176,7 @@ output: {every: 0.001, vtk: false}
         ADD_FAILURE() << "the run went on with fluid behind the floor";
       } catch (const std::runtime_error& e) {
         const std::string m = e.what();
-        EXPECT_EQ(m.rfind("test.yaml:6:", 0), 0u) << m;
+        EXPECT_EQ(m.rfind("test.yaml:5:", 0), 0u) << m;  // the key's line in tank()
         EXPECT_NE(m.find("1 fluid particles are behind"), std::string::npos) << m;
         EXPECT_NE(m.find("max_fluid_behind_walls"), std::string::npos) << m;
       }
