@@ -267,6 +267,9 @@ struct OutputSpec {
   bool vtk = true;              // write particles_NNNN.vtp and particles.pvd
   double checkpoint_every = 0;  // [s]; 0 = no checkpoints
   double forces_every = 0;      // forces.csv interval [s]; 0 = at every output (every step if every = 0)
+  bool forces_each_step = false;  // forces_every: step (a row after every time step)
+  double probes_every = 0;      // probes.csv interval [s]; 0 = at every output
+  bool probes_each_step = false;  // probes_every: step (a row after every time step)
 };
 
 struct NumericsSpec {

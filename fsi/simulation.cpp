@@ -1405,6 +1405,8 @@ void Simulation::resume(double time, std::uint64_t steps, std::uint64_t removed,
   solver_->resume(time, steps, removed);
   forces_index_ = 0;
   if (scene_.output.forces_every > 0) forces_index_ = next_index_after(time, scene_.output.forces_every, 0);
+  probes_index_ = 0;
+  if (scene_.output.probes_every > 0) probes_index_ = next_index_after(time, scene_.output.probes_every, 0);
   output_index_ = output_index;
   checkpoint_index_ = checkpoint_index;
   particle_steps_ = particle_steps;
@@ -1546,16 +1548,35 @@ void Simulation::run(Observer& observer) {
   const double ck_every = scene_.output.checkpoint_every;
   // Output k is due at time k * every; the first step at or past that time writes it.
   auto output_due = [&] { return every > 0 ? double(output_index_) * every : 0.0; };
-  if (output_index_ == 0 || time() >= output_due()) {
+  // probes.csv (a time column even without probes): every step, every probes_every, else at every
+  // output.
+  const double p_every = scene_.output.probes_every;
+  const bool p_step = scene_.output.probes_each_step;
+  auto probes_due = [&](bool output_now) {
+    if (p_step) return true;
+    if (p_every > 0) return time() >= double(probes_index_) * p_every;
+    return output_now;
+  };
+  auto write_probes = [&] {
+    observer.on_probes(*this);
+    if (p_every > 0) probes_index_ = next_index_after(time(), p_every, probes_index_);
+  };
+  const bool output_at_start = output_index_ == 0 || time() >= output_due();
+  if (output_at_start) {
     check_fluid_behind_walls();
     observer.on_output(*this);
     ++output_index_;
   }
-  // forces.csv: every forces_every, else at every output (every step without an output interval).
+  // A resumed run's row at its start time was written before the checkpoint.
+  if (p_step ? time() == 0.0 : probes_due(output_at_start)) write_probes();
+  // forces.csv: every step, every forces_every, else at every output (every step without an
+  // output interval).
   const bool structures = !scene_.structures.empty();
   const double f_every = scene_.output.forces_every;
+  const bool f_step = scene_.output.forces_each_step;
   auto forces_due = [&](bool output_now) {
     if (!structures) return false;
+    if (f_step) return true;
     if (f_every > 0) return time() >= double(forces_index_) * f_every;
     return output_now || every == 0;
   };
@@ -1582,6 +1603,7 @@ void Simulation::run(Observer& observer) {
       observer.on_output(*this);
       if (every > 0) output_index_ = next_index_after(time(), every, output_index_);
     }
+    if (probes_due(output_now)) write_probes();
     if (ck_every > 0 && time() >= double(checkpoint_index_ + 1) * ck_every) {
       checkpoint_index_ = next_index_after(time(), ck_every, checkpoint_index_ + 1) - 1;
       sync_to_host();

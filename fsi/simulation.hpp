@@ -80,6 +80,7 @@ class Observer {
   virtual void on_checkpoint(Simulation&) {}  // every checkpoint interval
   virtual void on_progress(const Simulation&) {}  // about twice a second of wall time
   virtual void on_forces(Simulation&) {}          // every forces interval (scenes with structures)
+  virtual void on_probes(Simulation&) {}          // every probes interval (scenes with probes)
   virtual void on_finish(Simulation&) {}
   // Polled after each step's outputs; true ends the run there, after an on_checkpoint (the
   // runner answers Ctrl-C and SIGTERM this way, so the work up to that step is kept).
@@ -196,6 +197,7 @@ class Simulation {
   std::uint64_t output_index_ = 0;
   std::uint64_t checkpoint_index_ = 0;
   std::uint64_t forces_index_ = 0;
+  std::uint64_t probes_index_ = 0;
   std::uint64_t particle_steps_ = 0;
   std::uint64_t fluid_particle_steps_ = 0;
   bool interrupted_ = false;

@@ -333,10 +333,10 @@ class Writers final : public fsi::Observer {
                    behind.deepest / sim.scene().particle_spacing);
       behind_told_ = behind.count;
     }
-    const auto values = sim.probe_values();
-    probes_->append(sim.time(), values);
     if (vtk_) vtk_->write(sim.store(), sim.time());
   }
+
+  void on_probes(fsi::Simulation& sim) override { probes_->append(sim.time(), sim.probe_values()); }
 
   void on_forces(fsi::Simulation& sim) override {
     if (forces_) forces_->append(sim.time(), fsi::force_row(sim.scene(), sim.structure_loads(), sim.body_kinematics()));

@@ -1618,8 +1618,18 @@ void Reader::read_probes(const Value& v, fsi::Scene& scene) const {
 }
 
 void Reader::read_output(const Value& v, fsi::OutputSpec& out) const {
-  MapView m(*this, v, {"every", "vtk", "checkpoint_every", "forces_every"});
-  if (auto x = m.get("forces_every")) out.forces_every = number(*x, non_negative(), "s");
+  MapView m(*this, v, {"every", "vtk", "checkpoint_every", "forces_every", "probes_every"});
+  // forces.csv and probes.csv rows: an interval in seconds, or `step` for a row after every time
+  // step (an impact peak lasts a few steps; issue #25 item 4).
+  const auto interval_or_step = [&](const Value& x, double& every, bool& each_step) {
+    if (x.node.IsScalar() && x.node.Scalar() == "step") {
+      each_step = true;
+      return;
+    }
+    every = number(x, {"'step' or a number >= 0", non_negative().ok}, "s");
+  };
+  if (auto x = m.get("forces_every")) interval_or_step(*x, out.forces_every, out.forces_each_step);
+  if (auto x = m.get("probes_every")) interval_or_step(*x, out.probes_every, out.probes_each_step);
   if (auto x = m.get("every")) out.every = number(*x, non_negative(), "s");
   if (auto x = m.get("vtk")) out.vtk = boolean(*x);
   if (auto x = m.get("checkpoint_every")) out.checkpoint_every = number(*x, non_negative(), "s");
@@ -1636,6 +1646,7 @@ std::string schedule_problem(double end, const fsi::OutputSpec& out) {
   };
   const Item items[] = {{out.every, 1e6, "output: every", "ParaView frames"},
                         {out.forces_every, 1e8, "output: forces_every", "force rows"},
+                        {out.probes_every, 1e8, "output: probes_every", "probe rows"},
                         {out.checkpoint_every, 1e5, "checkpoint_every", "checkpoints"}};
   for (const Item& it : items) {
     if (!(it.every > 0) || end / it.every <= it.most) continue;

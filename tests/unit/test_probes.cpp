@@ -128,3 +128,73 @@ TEST(PressureProbe, OneStrayParticleGivesNoReadingUnlessAsked) {
   EXPECT_TRUE(std::isnan(v[2])) << "one stray particle: " << v[2];
   EXPECT_FALSE(std::isnan(v[3])) << "min_kernel_sum 0 reads even one particle";
 }
+
+// Issue #25 item 4: probes have their own schedule, independent of the ParaView output, so a gauge
+// can sample an impact at every step without VTK frames at that rate. Reference: the schedule's
+// definition (a row at t = 0 and at the first step at or past each k * probes_every; `step`: a row
+// after every step; unset: at every output).
+namespace {
+
+struct ProbeTimes : fsi::Observer {
+  std::vector<double> probes, outputs;
+  std::size_t steps_seen = 0;
+  void on_probes(fsi::Simulation& sim) override { probes.push_back(sim.time()); }
+  void on_output(fsi::Simulation& sim) override { outputs.push_back(sim.time()); }
+  void on_progress(const fsi::Simulation&) override {}
+};
+
+fsi::Scene falling_block(double end) {
+  fsi::Scene s = layered_2d();
+  s.end_time = end;
+  s.output.every = end / 2;  // three outputs: 0, end / 2, end
+  fsi::ProbeSpec p;
+  p.name = "deep";
+  p.type = fsi::ProbeSpec::Type::pressure;
+  p.point = {0.5, 0.05, 0};
+  s.probes = {p};
+  return s;
+}
+
+}  // namespace
+
+TEST(ProbeSchedule, EveryStepGivesOneRowPerStepBesideTheStart) {
+  fsi::Scene s = falling_block(2e-3);
+  s.output.probes_each_step = true;
+  fsi::Simulation sim(s, {"cpu", 1});
+  sim.start();
+  ProbeTimes seen;
+  sim.run(seen);
+  ASSERT_GT(sim.steps(), 10u);
+  EXPECT_EQ(seen.probes.size(), sim.steps() + 1);
+  EXPECT_EQ(seen.outputs.size(), 3u) << "the VTK schedule is untouched";
+  for (std::size_t k = 1; k < seen.probes.size(); ++k) EXPECT_GT(seen.probes[k], seen.probes[k - 1]);
+  EXPECT_DOUBLE_EQ(seen.probes.back(), sim.time());
+}
+
+TEST(ProbeSchedule, OwnIntervalIsKeptWhateverTheOutputInterval) {
+  const double end = 4e-3, every = 2.5e-4;
+  fsi::Scene s = falling_block(end);
+  s.output.probes_every = every;
+  fsi::Simulation sim(s, {"cpu", 1});
+  sim.start();
+  ProbeTimes seen;
+  sim.run(seen);
+  const double dt_max = end / double(sim.steps()) * 3;  // the steps vary little in 4 ms of free fall
+  // Rows at 0 and at the first step at or past k * every for k = 1 .. 16: 17 in all.
+  ASSERT_EQ(seen.probes.size(), 17u);
+  for (std::size_t k = 0; k < seen.probes.size(); ++k) {
+    EXPECT_GE(seen.probes[k], double(k) * every - 1e-12) << "row " << k;
+    EXPECT_LT(seen.probes[k], double(k) * every + dt_max) << "row " << k;
+  }
+}
+
+TEST(ProbeSchedule, UnsetFollowsTheOutputs) {
+  fsi::Scene s = falling_block(2e-3);
+  fsi::Simulation sim(s, {"cpu", 1});
+  sim.start();
+  ProbeTimes seen;
+  sim.run(seen);
+  EXPECT_EQ(seen.probes, seen.outputs);
+  EXPECT_EQ(seen.probes.size(), 3u);
+}
+

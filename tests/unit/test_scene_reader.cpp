@@ -625,3 +625,24 @@ TEST(OutputSchedule, NextIndexMatchesCountingAndNeverLoops) {
   EXPECT_EQ(next_index_after(1.0, 1e-300, 0), std::numeric_limits<std::uint64_t>::max());
   EXPECT_EQ(next_index_after(1.0, 1e-9, 0), 1000000001u);
 }
+
+// Issue #25 item 4: probes.csv and forces.csv rows take an interval in seconds or `step`; anything
+// else is refused at the value with both forms named.
+TEST(SceneReader, ProbeAndForceRowsTakeAnIntervalOrStep) {
+  const std::string head =
+      "name: t\ndimensions: 2\nresolution: {particle_spacing: 0.01}\n"
+      "time: {end: 0.1}\nmaterials: {water: {density: 1000}}\nfluids: [{material: water, box: {min: [0, 0], max: [0.1, 0.1]}}]\n";
+  const auto unset = read_scene_string(head, "a.yaml").output;
+  EXPECT_FALSE(unset.probes_each_step);
+  EXPECT_EQ(unset.probes_every, 0.0);
+  const auto s = read_scene_string(head + "output: {every: 0.05, probes_every: step, forces_every: 0.001}\n", "b.yaml").output;
+  EXPECT_TRUE(s.probes_each_step);
+  EXPECT_FALSE(s.forces_each_step);
+  EXPECT_DOUBLE_EQ(s.forces_every, 0.001);
+  const auto f = read_scene_string(head + "output: {probes_every: 0.0005, forces_every: step}\n", "c.yaml").output;
+  EXPECT_DOUBLE_EQ(f.probes_every, 0.0005);
+  EXPECT_TRUE(f.forces_each_step);
+  const std::string bad = error_of_string(head + "output: {probes_every: steps}\n");
+  EXPECT_NE(bad.find("inline.yaml:7:24: error: "), std::string::npos) << bad;
+  EXPECT_NE(bad.find("'step' or a number >= 0"), std::string::npos) << bad;
+}
