@@ -4,12 +4,128 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
+#include <vector>
 
 #include "sph/dispatch.hpp"
 #include "sph/vec.hpp"
 
 namespace turbid::fsi {
 namespace {
+
+// Sample points of a sensor face centred on `c` and normal to `normal`: a segment of length `d` in
+// 2D, a disc of diameter `d` in 3D, sampled at about dx / 4 (9 to 33 points across), each point
+// the centre of an equal share of the face's area.
+template <int D>
+std::vector<std::array<double, 3>> sensor_face_points(const std::array<double, 3>& c, std::array<double, 3> normal,
+                                                      double d, double dx) {
+  double len = 0;
+  for (int k = 0; k < D; ++k) len += normal[std::size_t(k)] * normal[std::size_t(k)];
+  len = std::sqrt(len);
+  for (int k = 0; k < D; ++k) normal[std::size_t(k)] /= len;
+  const int across = std::min(33, std::max(9, int(std::ceil(4 * d / dx))));
+  std::vector<std::array<double, 3>> out;
+  if constexpr (D == 2) {
+    const std::array<double, 3> t{-normal[1], normal[0], 0};
+    for (int i = 0; i < across; ++i) {
+      const double s = d * ((i + 0.5) / across - 0.5);
+      out.push_back({c[0] + s * t[0], c[1] + s * t[1], 0});
+    }
+  } else {
+    // Two unit vectors in the face.
+    std::array<double, 3> a = std::abs(normal[0]) < 0.9 ? std::array<double, 3>{1, 0, 0} : std::array<double, 3>{0, 1, 0};
+    const double an = a[0] * normal[0] + a[1] * normal[1] + a[2] * normal[2];
+    for (int k = 0; k < 3; ++k) a[std::size_t(k)] -= an * normal[std::size_t(k)];
+    const double al = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    for (auto& v : a) v /= al;
+    const std::array<double, 3> b{normal[1] * a[2] - normal[2] * a[1], normal[2] * a[0] - normal[0] * a[2],
+                                  normal[0] * a[1] - normal[1] * a[0]};
+    // A square grid of `across` x `across` cells over the disc's bounding square; the cell centres
+    // inside the disc, each an equal share of its area.
+    for (int i = 0; i < across; ++i)
+      for (int j = 0; j < across; ++j) {
+        const double u = d * ((i + 0.5) / across - 0.5), v = d * ((j + 0.5) / across - 0.5);
+        if (u * u + v * v > 0.25 * d * d) continue;
+        out.push_back({c[0] + u * a[0] + v * b[0], c[1] + u * a[1] + v * b[1], c[2] + u * a[2] + v * b[2]});
+      }
+  }
+  return out;
+}
+
+// A wave gauge's reading at a station: the fluid fraction f(z) = sum_j W(|x_j - (X, z)|, h) V_j
+// along the vertical through the station, counting fluid (of the probe's material when given) and
+// walls and structures (the bed is not air), is 1 inside the water and 1/2 on a flat free surface.
+// From the lowest fluid particle near the station upwards, the first height where f falls below
+// 1/2 is the surface (found on a dx/2 grid and refined by bisection to dx/256): a jet or splash
+// above an air gap is not water level. No fluid near the station, or no height with f >= 1/2
+// (a film too thin to fill half a kernel), gives nan.
+template <int D>
+double gauge_elevation(const Scene& scene, const ProbeSpec& probe, const sph::ParticleStore& s,
+                       const sph::FieldIds& ids, const sph::PhysicsParams& params) {
+  using sph::Real;
+  using V = sph::Vec<D>;
+  const std::size_t n = s.size();
+  const V* x = s.data<V>(ids.position);
+  const Real* rho = s.data<Real>(ids.density);
+  const Real* m = s.data<Real>(ids.mass);
+  const std::uint8_t* mat = s.data<std::uint8_t>(ids.material);
+  const std::uint8_t* kind = s.data<std::uint8_t>(ids.kind);
+  const int want = probe.material.empty() ? -1 : material_index(scene, probe.material);
+  const int up = probe.axis;
+  const double h = params.smoothing_length, reach = 2 * h, dx = scene.particle_spacing;
+  // The particles within the kernel's reach of the vertical line, and where the fluid among them starts.
+  std::vector<std::size_t> near;
+  double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool is_fluid = kind[i] == std::uint8_t(sph::Kind::fluid);
+    if (is_fluid && want >= 0 && mat[i] != want) continue;
+    double r2 = 0;
+    for (int k = 0; k < D; ++k)
+      if (k != up) r2 += (double(x[i][k]) - probe.point[std::size_t(k)]) * (double(x[i][k]) - probe.point[std::size_t(k)]);
+    if (r2 >= reach * reach) continue;
+    near.push_back(i);
+    if (is_fluid) {
+      lowest = std::min(lowest, double(x[i][up]));
+      highest = std::max(highest, double(x[i][up]));
+    }
+  }
+  if (!std::isfinite(lowest)) return std::nan("");
+  double result = std::nan("");
+  sph::dispatch_kernel<D>(params, [&](auto kernel_tag, auto) {
+    using K = typename decltype(kernel_tag)::type;
+    auto fraction = [&](double z) {
+      V at;
+      for (int k = 0; k < D; ++k) at[k] = Real(probe.point[std::size_t(k)]);
+      at[up] = Real(z);
+      double f = 0;
+      for (std::size_t i : near) {
+        const double r = std::sqrt(double(sph::norm2(x[i] - at)));
+        if (r < reach) f += K::w(Real(r), Real(h)) * double(m[i]) / double(rho[i]);
+      }
+      return f;
+    };
+    const double step = 0.5 * dx;
+    double z = lowest;
+    bool in_water = false;
+    for (; z <= highest + reach; z += step) {
+      const double f = fraction(z);
+      if (!in_water) {
+        in_water = f >= 0.5;
+        continue;
+      }
+      if (f < 0.5) {
+        double lo = z - step, hi = z;  // f(lo) >= 1/2 > f(hi)
+        for (int it = 0; it < 7; ++it) {
+          const double mid = 0.5 * (lo + hi);
+          (fraction(mid) >= 0.5 ? lo : hi) = mid;
+        }
+        result = 0.5 * (lo + hi);
+        return;
+      }
+    }
+  });
+  return result;
+}
 
 template <int D>
 double evaluate(const Scene& scene, const ProbeSpec& probe, const sph::ParticleStore& s, const sph::FieldIds& ids,
@@ -35,24 +151,46 @@ double evaluate(const Scene& scene, const ProbeSpec& probe, const sph::ParticleS
       return std::isfinite(best) ? best : std::nan("");
     }
     case ProbeSpec::Type::pressure: {
-      // Shepard interpolation of fluid pressure: sum p_j W V_j / sum W V_j.
-      double num = 0, den = 0;
       const double h = params.smoothing_length;
-      V at;
-      for (int k = 0; k < D; ++k) at[k] = Real(probe.point[k]);
-      sph::dispatch_kernel<D>(params, [&](auto kernel_tag, auto) {
-        using K = typename decltype(kernel_tag)::type;
-        for (std::size_t i = 0; i < n; ++i) {
-          if (!fluid(i)) continue;
-          const double r = std::sqrt(double(sph::norm2(x[i] - at)));
-          if (r >= 2 * h) continue;
-          const double w = K::w(Real(r), Real(h)) * double(m[i]) / double(rho[i]);
-          num += w * p[i];
-          den += w;
-        }
-      });
-      // No reading where too little fluid is near the point (a dry sensor, one stray particle).
-      return den > 0 && den >= probe.min_kernel_sum ? num / den : std::nan("");
+      // The fluid within reach of the point or of any point of the sensor's face.
+      const double reach = 2 * h + 0.5 * std::max(0.0, probe.sensor_diameter);
+      V centre;
+      for (int k = 0; k < D; ++k) centre[k] = Real(probe.point[std::size_t(k)]);
+      std::vector<std::size_t> near;
+      for (std::size_t i = 0; i < n; ++i)
+        if (fluid(i) && double(sph::norm2(x[i] - centre)) < reach * reach) near.push_back(i);
+      // Shepard interpolation of fluid pressure at one point: sum p_j W V_j / sum W V_j, or nan
+      // where too little fluid is near it (a dry sensor, one stray particle).
+      auto at_point = [&](const std::array<double, 3>& q) {
+        double num = 0, den = 0;
+        V at;
+        for (int k = 0; k < D; ++k) at[k] = Real(q[std::size_t(k)]);
+        sph::dispatch_kernel<D>(params, [&](auto kernel_tag, auto) {
+          using K = typename decltype(kernel_tag)::type;
+          for (std::size_t i : near) {
+            const double r = std::sqrt(double(sph::norm2(x[i] - at)));
+            if (r >= 2 * h) continue;
+            const double w = K::w(Real(r), Real(h)) * double(m[i]) / double(rho[i]);
+            num += w * p[i];
+            den += w;
+          }
+        });
+        return den > 0 && den >= probe.min_kernel_sum ? num / den : std::nan("");
+      };
+      if (probe.sensor_diameter <= 0) return at_point(probe.point);
+      // A wall sensor: the mean over its face, each sample standing for an equal share of the area;
+      // samples without fluid read ambient 0, and a face wholly dry reads nan.
+      const auto samples = sensor_face_points<D>(probe.point, probe.sensor_normal, probe.sensor_diameter,
+                                                 scene.particle_spacing);
+      double sum = 0;
+      bool wet = false;
+      for (const auto& q : samples) {
+        const double v_q = at_point(q);
+        if (std::isnan(v_q)) continue;
+        sum += v_q;
+        wet = true;
+      }
+      return wet ? sum / double(samples.size()) : std::nan("");
     }
     case ProbeSpec::Type::max_speed: {
       double v2 = 0;
@@ -71,7 +209,9 @@ double evaluate(const Scene& scene, const ProbeSpec& probe, const sph::ParticleS
       for (std::size_t i = 0; i < n; ++i) c += fluid(i) ? 1 : 0;
       return double(c);
     }
-    case ProbeSpec::Type::surface_elevation: {
+    case ProbeSpec::Type::surface_elevation:
+      return gauge_elevation<D>(scene, probe, s, ids, params);
+    case ProbeSpec::Type::highest_particle: {
       // Particles count for the station when their horizontal distance to it is below dx. A
       // narrower band could miss every column (in 3D a disc must reach dx/sqrt(2) to hold a point of
       // a square lattice however the station falls, and disordered particles wander by a fraction
@@ -115,6 +255,7 @@ const char* probe_unit(ProbeSpec::Type t) {
     case ProbeSpec::Type::kinetic_energy: return "J";
     case ProbeSpec::Type::fluid_particles: return "1";
     case ProbeSpec::Type::surface_elevation: return "m";
+    case ProbeSpec::Type::highest_particle: return "m";
     case ProbeSpec::Type::material_mass: return "kg";
   }
   return "";

@@ -224,10 +224,14 @@ struct ProbeSpec {
     max_speed,       // largest fluid particle speed [m/s]
     kinetic_energy,  // total fluid kinetic energy [J] (per metre of depth in 2D)
     fluid_particles, // number of fluid particles [-]
-    // free-surface elevation at a station [m]: the highest fluid (of `material`) along the vertical
-    // `axis` among particles horizontally within dx of `point`, see fsi/probes.cpp
+    // free-surface elevation at a station [m], as a wave gauge reads it: the lowest height above the
+    // bed at which the interpolated fluid fraction along the vertical `axis` through `point` drops
+    // below one half (a splash above the water column does not count), see fsi/probes.cpp
     surface_elevation,
     material_mass,   // total mass of the fluid of `material` [kg] (per metre of depth in 2D: kg/m)
+    // the highest fluid particle (of `material`) horizontally within dx of the station plus dx/2 [m]:
+    // surface_elevation's definition before issue #25 (a splash or jet reads as water level)
+    highest_particle,
   };
   std::string name;
   Type type = Type::max_speed;
@@ -239,6 +243,11 @@ struct ProbeSpec {
   // 0.5 on a flat wall, 0.25 in a corner) for a reading; below it the probe writes nan. One stray
   // particle at the point gives 0.14 (2D) or 0.05 (3D) with h = 2 dx.
   double min_kernel_sum = 0.2;
+  // pressure as a wall sensor reads it: the average over a face of this diameter [m] centred on
+  // `point` and normal to `sensor_normal` (a segment in 2D, a disc in 3D); the parts of the face
+  // without fluid read 0 (ambient). 0: the pressure at the point.
+  double sensor_diameter = 0;
+  Vec3d sensor_normal{1, 0, 0};
   SourceLocation where;
 };
 

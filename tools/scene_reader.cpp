@@ -1535,10 +1535,10 @@ void Reader::read_probes(const Value& v, fsi::Scene& scene) const {
   std::vector<std::string> material_names;
   for (const auto& m : scene.materials) material_names.push_back(m.name);
   const std::vector<std::string> types = {"front_position", "pressure", "max_speed", "kinetic_energy",
-                                          "fluid_particles", "surface_elevation", "material_mass"};
+                                          "fluid_particles", "surface_elevation", "material_mass", "highest_particle"};
   std::map<std::string, int> first_line;
   for (const Value& item : list(v)) {
-    MapView m(*this, item, {"name", "type", "material", "axis", "point", "at", "min_kernel_sum"});
+    MapView m(*this, item, {"name", "type", "material", "axis", "point", "at", "min_kernel_sum", "sensor"});
     fsi::ProbeSpec probe;
     probe.where = where(item.mark);
     const Value nv = m.need("name");
@@ -1559,13 +1559,15 @@ void Reader::read_probes(const Value& v, fsi::Scene& scene) const {
     probe.type = static_cast<fsi::ProbeSpec::Type>(t);
     std::vector<std::string> uses;
     if (probe.type == fsi::ProbeSpec::Type::front_position) uses = {"material", "axis"};
-    if (probe.type == fsi::ProbeSpec::Type::pressure) uses = {"point", "min_kernel_sum"};
-    if (probe.type == fsi::ProbeSpec::Type::surface_elevation) uses = {"material", "at"};
+    const bool station = probe.type == fsi::ProbeSpec::Type::surface_elevation ||
+                         probe.type == fsi::ProbeSpec::Type::highest_particle;
+    if (probe.type == fsi::ProbeSpec::Type::pressure) uses = {"point", "min_kernel_sum", "sensor"};
+    if (station) uses = {"material", "at"};
     if (probe.type == fsi::ProbeSpec::Type::material_mass) {
       uses = {"material"};
       m.need("material");
     }
-    for (const char* key : {"material", "axis", "point", "at", "min_kernel_sum"})
+    for (const char* key : {"material", "axis", "point", "at", "min_kernel_sum", "sensor"})
       if (m.has(key) && std::find(uses.begin(), uses.end(), key) == uses.end())
         fail(m.key_mark(key), "'" + std::string(key) + "' does not apply to a '" + types[t] + "' probe");
 
@@ -1588,7 +1590,17 @@ void Reader::read_probes(const Value& v, fsi::Scene& scene) const {
         fail(kv->mark, "'min_kernel_sum' is a fraction of the full kernel sum (1 inside the fluid), below 1; got " +
                            fmt(probe.min_kernel_sum));
     }
-    if (probe.type == fsi::ProbeSpec::Type::surface_elevation) {
+    if (auto sv = m.get("sensor")) {
+      // A wall sensor's face: {diameter: D [m], normal: [..]} (the normal need not be unit length).
+      MapView sm(*this, *sv, {"diameter", "normal"});
+      probe.sensor_diameter = number(sm.need("diameter"), positive(), "m");
+      const Value nv = sm.need("normal");
+      probe.sensor_normal = point(nv, dims, "");
+      double len2 = 0;
+      for (double c : probe.sensor_normal) len2 += c * c;
+      if (!(len2 > 0) || !std::isfinite(len2)) fail(nv.mark, "the sensor's 'normal' must be a non-zero vector");
+    }
+    if (station) {
       // The elevation is measured along the last axis (y in 2D, z in 3D), the one the default
       // gravity points down; `at` gives the station's other coordinates. A scene whose gravity
       // does not point mostly down that axis has no such vertical, so the probe is refused.
@@ -1597,7 +1609,7 @@ void Reader::read_probes(const Value& v, fsi::Scene& scene) const {
       const bool down = g[std::size_t(up)] < 0 && std::abs(g[std::size_t(up)]) >= std::abs(g[0]) &&
                         std::abs(g[std::size_t(up)]) >= std::abs(g[1]) && std::abs(g[std::size_t(up)]) >= std::abs(g[2]);
       if (!down)
-        fail(tv.mark, "a 'surface_elevation' probe measures along " + std::string(kAxisName[up]) +
+        fail(tv.mark, "a '" + types[t] + "' probe measures along " + std::string(kAxisName[up]) +
                           " and needs gravity pointing mainly down that axis, got gravity [" + fmt(g[0]) + ", " +
                           fmt(g[1]) + (dims == 3 ? ", " + fmt(g[2]) : std::string()) + "]");
       probe.axis = up;

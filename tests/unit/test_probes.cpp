@@ -1,4 +1,4 @@
-// The surface_elevation probe (fsi/probes.cpp) on known particle sets: the initial lattice of a
+// The station probes (fsi/probes.cpp) on known particle sets: the initial lattice of a
 // flat-topped block. Reference: a block filled to height H has its top row at H - dx/2, and the
 // probe reports the top particle's centre plus dx/2, so it reads H up to float rounding of the
 // positions (1e-6 m here), far inside the half spacing the free surface is uncertain by.
@@ -21,10 +21,12 @@ fsi::MaterialSpec material(const char* name, double density) {
   return m;
 }
 
-fsi::ProbeSpec elevation(const char* name, double x, double y = 0, const char* material_name = "") {
+// The highest-particle reading (surface_elevation's definition before issue #25 item 3).
+fsi::ProbeSpec elevation(const char* name, double x, double y = 0, const char* material_name = "",
+                         fsi::ProbeSpec::Type type = fsi::ProbeSpec::Type::highest_particle) {
   fsi::ProbeSpec p;
   p.name = name;
-  p.type = fsi::ProbeSpec::Type::surface_elevation;
+  p.type = type;
   p.point = {x, y, 0};
   p.material = material_name;
   return p;
@@ -50,7 +52,7 @@ fsi::Scene layered_2d() {
   return s;
 }
 
-TEST(SurfaceElevationProbe, FlatBlockReadsItsTopAndEachMaterialItsOwn) {
+TEST(HighestParticleProbe, FlatBlockReadsItsTopAndEachMaterialItsOwn) {
   fsi::Scene s = layered_2d();
   for (auto& p : std::vector<fsi::ProbeSpec>{elevation("eta", 0.5), elevation("mud_top", 0.5, 0, "mud"),
                                              elevation("edge_in", 1.004), elevation("edge_out", 1.006),
@@ -70,7 +72,7 @@ TEST(SurfaceElevationProbe, FlatBlockReadsItsTopAndEachMaterialItsOwn) {
   EXPECT_TRUE(std::isnan(v[4])) << "a station far from any fluid: " << v[4];
 }
 
-TEST(SurfaceElevationProbe, ThreeDimensionalStationIsAnXyPoint) {
+TEST(HighestParticleProbe, ThreeDimensionalStationIsAnXyPoint) {
   // 3D: water 1 m x 0.15 m up to z = 0.3 m, dx = 0.02; stations given as (x, y), vertical z.
   fsi::Scene s;
   s.name = "flat3d";
@@ -93,6 +95,61 @@ TEST(SurfaceElevationProbe, ThreeDimensionalStationIsAnXyPoint) {
   EXPECT_NEAR(v[1], 0.3, kRounding) << "station at the corner column (0.01, 0.01), 0.013 m < dx away";
   // The last y row is at 0.15, 0.05 m from y = 0.2: beyond dx, so no fluid at that station.
   EXPECT_TRUE(std::isnan(v[2])) << v[2];
+}
+
+// Issue #25 item 3: surface_elevation reads as a wave gauge does, where the interpolated fluid
+// fraction along the vertical falls below one half, so a splash above the water is not its level.
+// Reference: a flat free surface at H has fraction 1/2 at H for a continuous half space; on the
+// lattice (rows dx/2 below H and every dx further down) the sums are midpoint rules of that
+// integral, and the crossing is bisected to dx/256: measured 0.002 dx off, tolerance 0.01 dx. The
+// old highest-particle reading is kept as highest_particle, and reads the blob.
+TEST(SurfaceElevationProbe, GaugeReadsTheWaterNotTheSplashAbove) {
+  fsi::Scene s = layered_2d();
+  fsi::FluidBlock blob;  // 3 x 3 particles 0.1 m above the water at x = 0.5
+  blob.material = "water";
+  blob.box = {{0.485, 0.4, 0}, {0.515, 0.43, 0}};
+  s.fluids.push_back(blob);
+  const auto gauge = fsi::ProbeSpec::Type::surface_elevation;
+  for (auto p : {elevation("gauge", 0.5, 0, "", gauge), elevation("highest", 0.5), elevation("mud_gauge", 0.5, 0, "mud", gauge),
+                 elevation("beside", 0.8, 0, "", gauge), elevation("away", 2.0, 0, "", gauge)}) {
+    p.axis = 1;
+    s.probes.push_back(p);
+  }
+  fsi::Simulation sim(s, {"cpu", 1});
+  const std::vector<double> v = sim.probe_values();
+  ASSERT_EQ(v.size(), 5u);
+  const double dx = s.particle_spacing;
+  EXPECT_NEAR(v[0], 0.3, 0.01 * dx) << "the water under the splash";
+  EXPECT_NEAR(v[1], 0.43, kRounding) << "highest_particle: the splash's top";
+  EXPECT_NEAR(v[2], 0.1, 0.01 * dx) << "mud: the water above counts as not mud";
+  EXPECT_NEAR(v[3], 0.3, 0.01 * dx) << "a station with no splash above";
+  EXPECT_TRUE(std::isnan(v[4])) << "no fluid near the station: " << v[4];
+}
+
+// Issue #25 item 1: a pressure probe may read as a wall sensor, the mean over a face of a stated
+// diameter. Reference: hydrostatic pressure is linear in depth, so the mean over a face centred at
+// a depth equals the pressure there (within the 1% of the point reading, PressureProbe above); a
+// face wholly above the water reads nan, and a face half in the water reads about half the mean of
+// its wet half (dry samples read ambient 0).
+TEST(PressureProbe, SensorFaceAveragesOverItsDiameter) {
+  fsi::Scene s = layered_2d();
+  auto sensor = [](const char* name, double y, double d) {
+    fsi::ProbeSpec p;
+    p.name = name;
+    p.type = fsi::ProbeSpec::Type::pressure;
+    p.point = {0.5, y, 0};
+    p.sensor_diameter = d;
+    p.sensor_normal = {1, 0, 0};  // a face along y, as on a wall normal to x
+    return p;
+  };
+  s.probes = {sensor("deep", 0.2, 0.06), sensor("dry", 0.5, 0.06), sensor("point", 0.2, 0)};
+  fsi::Simulation sim(s, {"cpu", 1});
+  sim.start();
+  const std::vector<double> v = sim.probe_values();
+  ASSERT_EQ(v.size(), 3u);
+  EXPECT_NEAR(v[0], 1000 * 9.81 * 0.1, 0.01 * 1000 * 9.81 * 0.1) << "centre 0.1 m under the surface";
+  EXPECT_NEAR(v[0], v[2], 0.01 * v[2]) << "the face's mean and the point reading";
+  EXPECT_TRUE(std::isnan(v[1])) << v[1];
 }
 
 }  // namespace
