@@ -301,6 +301,9 @@ struct NumericsSpec {
   // Walls and structures show the viscous terms the fluid's velocity mirrored at their ghost nodes
   // (no-slip at the wall surface); unset: yes where a material has the full viscous stress.
   std::optional<bool> no_slip;
+  // Fluid that crossed a wall or structure surface is put back on it after each drift
+  // (sph::WallConstraintPass); `boundary: {impermeable: false}` leaves walls to their pressure alone.
+  bool impermeable = true;
   bool interface_correction = true;        // ghost-density correction across material interfaces (paper eq. 3)
   int split_relaxation = 10;               // relaxation steps after each split (sph/splitting.hpp); 0 = off
   double shifting_coefficient = 0;         // particle shifting A [-]; 0 = off

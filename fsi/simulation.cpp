@@ -730,6 +730,8 @@ sph::PhysicsParams physics_params(const Scene& scene) {
   // kink into the profile at the wall, the gradients average it away and the wall shear comes out
   // at about half (a yield-stress layer slid on DBC walls); by default its walls mirror the fluid.
   p.wall_no_slip = scene.numerics.no_slip.value_or(p.full_stress);
+  p.wall_constraint = scene.numerics.impermeable && (!scene.walls.empty() || !scene.structures.empty());
+  p.wall_constraint_band = sph::Real(0.5 * scene.particle_spacing);
   for (const auto& w : scene.walls) p.free_slip_walls = p.free_slip_walls || w.free_slip;
   p.body_count = int(scene.structures.size());
   p.zone_count = int(scene.open_boundaries.size());

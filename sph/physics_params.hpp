@@ -74,6 +74,10 @@ struct PhysicsParams {
   Viscosity viscosity = Viscosity::artificial;
   Boundary boundary = Boundary::dbc;
   bool wall_no_slip = false;   // boundary velocity in viscous terms mirrors the fluid's (no-slip), else stays the wall's
+  // Impermeable walls (WallConstraintPass): after the drift a fluid particle behind the surface of
+  // every wall or structure particle near it is put back on that surface (needs boundary_normal).
+  bool wall_constraint = false;
+  Real wall_constraint_band = Real(0);  // boundary particles within nearest + band decide [m] (dx / 2)
   Real mdbc_wet_share = Real(0.5);  // mDBC: a ghost node with less fluid than this share of its support is dry
   // Some walls are free-slip: their particles carry the `free_slip` field, and the viscous terms
   // (laminar viscosity, velocity gradient) leave them out.

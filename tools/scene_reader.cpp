@@ -684,9 +684,10 @@ void Reader::read_numerics(const Value& v, fsi::NumericsSpec& n) const {
                          std::to_string(n.split_relaxation));
   }
   if (auto bv = m.get("boundary")) {
-    MapView b(*this, *bv, {"type", "velocity"});
+    MapView b(*this, *bv, {"type", "velocity", "impermeable"});
     n.boundary = choice(b.need("type"), {"dbc", "mdbc"}) == 0 ? fsi::BoundaryKind::dbc : fsi::BoundaryKind::mdbc;
     if (auto vel = b.get("velocity")) n.no_slip = choice(*vel, {"no_slip", "wall"}) == 0;
+    if (auto imp = b.get("impermeable")) n.impermeable = boolean(*imp);
   }
   if (auto k = m.get("kernel"))
     n.kernel = choice(*k, {"wendland_c2", "cubic_spline"}) == 0 ? sph::KernelKind::wendland_c2

@@ -155,8 +155,10 @@ TEST(FluidBehindWalls, ATankAtRestHasNoneBehindItsWalls) {
 // the key's line and the count; within the limit the run goes on.
 TEST(FluidBehindWalls, MoreThanTheScenesLimitStopsTheRunAtItsLine) {
   for (int limit : {0, 1}) {
-    const std::string yaml =
-        tank("  max_fluid_behind_walls: " + std::to_string(limit), "time: {end: 0.002}\noutput: {every: 0.001, vtk: false}\n");
+    // Walls left to their pressure alone (impermeable walls would put the particle back).
+    const std::string yaml = tank("  max_fluid_behind_walls: " + std::to_string(limit) +
+                                      "\n  boundary: {type: dbc, impermeable: false}",
+                                  "time: {end: 0.002}\noutput: {every: 0.001, vtk: false}\n");
     fsi::Simulation sim(test::scene_of(yaml), test::cpu());
     sim.start();
     // Put one fluid particle of the bottom row 0.3 dx below the floor's surface (y = 0), past the
@@ -185,6 +187,59 @@ TEST(FluidBehindWalls, MoreThanTheScenesLimitStopsTheRunAtItsLine) {
       EXPECT_LE(sim.fluid_behind_walls().count, 1u);
     }
   }
+}
+
+// Impermeable walls (sph::WallConstraintPass, issue #27 item 9). Reference: the pass's definition:
+// a fluid particle behind the surface of the boundary particles near it is put on that surface
+// (signed distance 0, to float rounding of positions of O(1) m: 1e-6 m) and its velocity into the
+// wall removed; its tangential velocity is the kick's alone; fluid in front of every surface moves
+// exactly as without the pass (bit for bit).
+TEST(ImpermeableWalls, FluidPastTheFloorIsPutBackOnItsSurface) {
+  struct Result {
+    float y_moved, v_moved, u_moved;  // the particle pushed below the floor
+    std::vector<float> others;        // every other fluid particle's position after the steps
+  };
+  auto run = [](bool impermeable) {
+    const std::string yaml =
+        tank(std::string("  boundary: {type: dbc, impermeable: ") + (impermeable ? "true" : "false") + "}",
+             "time: {end: 0.001}\ngravity: [0, 0]\noutput: {every: 0, vtk: false}\n");
+    fsi::Simulation sim(test::scene_of(yaml), test::cpu());
+    sim.start();
+    auto& st = sim.store();
+    auto* x = static_cast<float*>(st.raw(sim.fields().position));
+    auto* v = static_cast<float*>(st.raw(sim.fields().velocity));
+    const auto* kind = st.data<std::uint8_t>(sim.fields().kind);
+    const auto* id = st.data<std::uint32_t>(sim.fields().id);
+    std::uint32_t moved = 0;
+    for (std::size_t i = 0; i < st.size(); ++i)
+      if (kind[i] == std::uint8_t(Kind::fluid) && x[2 * i + 1] < 0.011f && x[2 * i] > 0.4f) {
+        x[2 * i + 1] = -0.006f;  // 0.3 dx below the floor's surface (y = 0), heading down and along
+        v[2 * i] = 0.5f;
+        v[2 * i + 1] = -1.0f;
+        moved = id[i];
+        break;
+      }
+    sim.step(1e-4);
+    Result r{};
+    for (std::size_t i = 0; i < st.size(); ++i) {
+      if (kind[i] != std::uint8_t(Kind::fluid)) continue;
+      if (id[i] == moved) {
+        r.y_moved = x[2 * i + 1];
+        r.u_moved = v[2 * i];
+        r.v_moved = v[2 * i + 1];
+      } else if (x[2 * i + 1] > 0.1f) {  // away from the moved particle's neighbourhood
+        r.others.push_back(x[2 * i]);
+        r.others.push_back(x[2 * i + 1]);
+      }
+    }
+    return r;
+  };
+  const Result on = run(true), off = run(false);
+  EXPECT_NEAR(on.y_moved, 0.0f, 1e-6f) << "put back on the floor's surface";
+  EXPECT_GE(on.v_moved, 0.0f) << "no velocity into the floor after the pass";
+  EXPECT_LT(off.y_moved, -0.006f) << "without the pass it goes on down: " << off.y_moved;
+  EXPECT_LT(off.v_moved, 0.0f);
+  EXPECT_EQ(on.others, off.others) << "fluid in front of the walls is not touched";
 }
 
 }  // namespace

@@ -118,6 +118,9 @@ TEST(ValidationDamBreak, SurgeFrontMatchesMartinMoyce1952) {
             << " particles\n";
   RecordProperty("rms_relative_front_error", std::to_string(rms));
   EXPECT_LT(rms, kTolerance) << "surge front vs Martin & Moyce (1952)";
+  // Impermeable walls (issue #27 item 9): no fluid more than dx/4 behind the tank's walls at any
+  // output (fsi/wall_penetration.hpp).
+  EXPECT_EQ(report.at("fluid_behind_walls_max").get<std::uint64_t>(), 0u);
 
   double best_shift = 0, best_rms = rms;
   for (int k = 1; k <= 80; ++k) {

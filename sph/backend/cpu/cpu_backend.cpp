@@ -543,6 +543,8 @@ class CpuBackend final : public Backend {
   void drift_impl(Real dt) {
     parallel_for(std::uint32_t(store_->size()),
                  DriftPass<D>{view<D>(), dt, params_.materials[params_.wall_material].eos.no_tension_density(), params_});
+    if (params_.wall_constraint)
+      parallel_for(std::uint32_t(store_->size()), WallConstraintPass<D>{view<D>(), grid<D>(), params_, list(false)});
   }
 
   template <int D>

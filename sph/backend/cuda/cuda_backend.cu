@@ -307,6 +307,11 @@ class CudaBackend final : public Backend {
     const Real wall_rho_min = params_.materials[params_.wall_material].eos.no_tension_density();
     if (params_.dimensions == 2) launch("DriftPass<2>", n_, DriftPass<2>{view<2>(), Real(dt), wall_rho_min, params_});
     else launch("DriftPass<3>", n_, DriftPass<3>{view<3>(), Real(dt), wall_rho_min, params_});
+    if (!params_.wall_constraint) return;
+    if (params_.dimensions == 2)
+      launch("WallConstraintPass<2>", n_, WallConstraintPass<2>{view<2>(), grid<2>(), params_, NeighbourList{}});
+    else
+      launch("WallConstraintPass<3>", n_, WallConstraintPass<3>{view<3>(), grid<3>(), params_, NeighbourList{}});
   }
 
   // Conversions at open boundaries run on the host (few particles change; the store is copied
