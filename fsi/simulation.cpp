@@ -176,12 +176,16 @@ Point ghost_container(const Box& box, const Point& x, int d) {
   return n;
 }
 
-Point ghost_solid_box(const Box& box, const Point& x, int d) {
-  // Particles fill the box; the nearest face is the surface.
+// hidden[2 k] / hidden[2 k + 1]: the min / max face on axis k rests on another wall (a box on the
+// floor of its tank), so no fluid reaches it and it is not a surface.
+Point ghost_solid_box(const Box& box, const Point& x, int d, const std::array<bool, 6>& hidden) {
+  // Particles fill the box; the nearest exposed face is the surface.
   int best_axis = 0;
   double best = std::numeric_limits<double>::infinity(), target = 0;
   for (int k = 0; k < d; ++k) {
-    for (double face : {box.min[k], box.max[k]}) {
+    for (int side = 0; side < 2; ++side) {
+      if (hidden[std::size_t(2 * k + side)]) continue;
+      const double face = side == 0 ? box.min[k] : box.max[k];
       const double dist = std::abs(face - x[k]);
       if (dist < best) {
         best = dist;
@@ -1221,6 +1225,19 @@ void Simulation::build_particles() {
   }
 
   const auto& wall_eos = params_.materials[params_.wall_material].eos;
+  // The faces of a solid box that rest on a container's inner face (a box on its tank's floor).
+  auto hidden_faces = [&](const geometry::Aabb& b) {
+    std::array<bool, 6> hidden{};
+    for (std::size_t w = 0; w < s.walls.size(); ++w) {
+      if (s.walls[w].kind != WallSpec::Kind::container) continue;
+      const geometry::Aabb& c = wall_cells[w];
+      for (int k = 0; k < d; ++k) {
+        if (std::abs(b.min[k] - c.min[k]) < 0.5 * dx) hidden[std::size_t(2 * k)] = true;
+        if (std::abs(b.max[k] - c.max[k]) < 0.5 * dx) hidden[std::size_t(2 * k + 1)] = true;
+      }
+    }
+    return hidden;
+  };
   std::vector<std::size_t> wall_first;  // items of wall w: [wall_first[w], wall_first[w + 1])
   for (const auto& w : s.walls) {
     wall_first.push_back(items.size());
@@ -1246,7 +1263,7 @@ void Simulation::build_particles() {
       const geometry::Aabb& built = wall_cells[std::size_t(&w - s.walls.data())];
       switch (w.kind) {
         case WallSpec::Kind::container: ghost = ghost_container({built.min, built.max}, x, d); break;
-        case WallSpec::Kind::solid_box: ghost = ghost_solid_box({built.min, built.max}, x, d); break;
+        case WallSpec::Kind::solid_box: ghost = ghost_solid_box({built.min, built.max}, x, d, hidden_faces(built)); break;
         case WallSpec::Kind::polyline: ghost = ghost_polyline(w, x, d); break;
       }
       const double rho = layered ? layered_density(wall_eos, x, true) : wall_eos.hydrostatic_density(g, depth);

@@ -78,18 +78,30 @@ FluidBehindWalls count_fluid_behind_walls(const PenetrationInput& in) {
           }
         }
     if (near.empty()) continue;
-    // Behind every surface near it: at a convex edge the nearest particle may stand for one face
-    // only (a box's top row beside its side face), so all particles within `band` of the nearest
-    // distance must agree.
+    // The rule of sph::WallConstraintPass (its comment): behind some surface within `band` of the
+    // nearest (e the least behind), and not in front of a surface that meets e's at a convex edge.
     const double reach = std::sqrt(best) + in.band;
+    const auto within = [&](double r2) { return r2 <= best || r2 <= reach * reach; };
     double s_max = -std::numeric_limits<double>::infinity();
     std::uint32_t deciding = near.front().second;
+    bool behind = false;
     for (const auto& [r2, b] : near) {
-      if (r2 > best && r2 > reach * reach) continue;
+      if (!within(r2)) continue;
       const double s = surface_distance(xi, b);
-      if (std::isnan(s)) continue;
-      if (s > s_max) s_max = s, deciding = b;
+      if (std::isnan(s) || s >= 0) continue;
+      if (!behind || s > s_max) s_max = s, deciding = b;
+      behind = true;
     }
+    if (!behind) continue;
+    const float* xe = in.position + std::size_t(deciding) * std::size_t(d);
+    bool outside = false;
+    for (const auto& [r2, b] : near) {
+      if (outside || !within(r2)) continue;
+      const double s = surface_distance(xi, b);
+      if (std::isnan(s) || s < 0) continue;
+      outside = surface_distance(xe, b) < 0;  // e behind the plane of b: a convex edge
+    }
+    if (outside) continue;
     if (s_max < -in.tolerance) {
       ++out.count;
       out.deepest = std::max(out.deepest, -s_max);

@@ -10,10 +10,12 @@
 // the hollow between four wall particles of a 3D layer, 0.75 dx from each (close, but it happens
 // under an impact), stands sqrt(0.75^2 - 0.5) dx = 0.25 dx above their plane, dx/4 beyond the
 // surface, without having gone through anything; deeper than that it is among the wall's layers. Moving
-// structures carry their ghost offsets with their rotation (g = R g0). Near a convex edge the nearest
-// particle may stand for one face only (the top row of a box, beside its side face), so the particle
-// counts only when it is behind the surfaces of all boundary particles within `band` (dx/2) of the
-// nearest distance: beside a box it is in front of the side face's particles, inside it behind all.
+// structures carry their ghost offsets with their rotation (g = R g0). The boundary particles within
+// `band` (dx/2) of the nearest distance decide, by the rule of sph::WallConstraintPass, which puts
+// such fluid back on the surface: behind some of their surfaces (e the one it is least behind) and
+// not in front of a surface that meets e's at a convex edge (e behind that surface's plane). Beside a
+// box's side face, behind the plane of its top row, a particle is outside; inside a box standing on
+// the floor, above the floor's surface, it is inside (a concave junction).
 #pragma once
 #include <array>
 #include <cstddef>

@@ -324,16 +324,18 @@ struct StructureForcePass {
 
 // Impermeable walls (issue #27 item 9). DBC and mDBC keep fluid out of walls by pressure alone,
 // and a film that arrives thin and fast, or fluid in tension, can pass through before that pressure
-// builds (docs/validation.md, W). After the drift, fluid particle i is behind the wall when, for
-// every boundary particle b within `band` of the nearest one, its signed distance to b's surface
+// builds (docs/validation.md, W). After the drift, the boundary particles within `band` of fluid
+// particle i's nearest decide, by i's signed distance to each one's surface,
 //   s_b = (x_i - x_b) . n_b - |g_b| / 2,   n_b = g_b / |g_b|
-// (g_b the ghost offset, twice b's depth below the surface, boundary_normal) is negative; near a
-// convex edge the particles of the other face keep it in front (fsi/wall_penetration.hpp counts by
-// the same rule). It is then put back on the surface it is least behind, x_i -= s_b n_b, and its
-// velocity into that wall relative to b's removed (an inelastic stop; the tangential velocity is
-// kept). Fluid in front of a surface is untouched, so the pass changes nothing in flows that keep
-// out of walls on their own. The neighbours are those of the step's start: walls move less than a
-// spacing per step.
+// (g_b the ghost offset, twice b's depth below the surface: boundary_normal). i is behind the wall
+// when it is behind some of those surfaces (s_b < 0; e the one it is least behind) and no surface
+// it is in front of (s_b' >= 0) meets e's at a convex edge, that is with e behind the plane of b'
+// (beside a box's side face, behind the plane of its top row, i is outside; above the floor but
+// inside a box standing on it, a concave junction, i is inside). fsi/wall_penetration.cpp counts by
+// the same rule. i is then put on e's surface, x_i -= s_e n_e, and its velocity into that wall,
+// relative to e's, removed (an inelastic stop; the tangential velocity is kept). Fluid in front of
+// the walls is untouched, so the pass changes nothing in flows that keep out of walls on their own.
+// The neighbours are those of the step's start: walls move less than a spacing per step.
 template <int D>
 struct WallConstraintPass {
   ParticleView<D> P;
@@ -348,35 +350,48 @@ struct WallConstraintPass {
   TURBID_HD void operator()(std::uint32_t i) const {
     if (P.kind[i] != std::uint8_t(Kind::fluid)) return;
     const Vec<D> xi = P.position[i];
+    int c[D] = {};
+    if (G.cell_of(xi, c) && !G.boundary_near(c)) return;  // most fluid: no wall within a cell
     Real nearest2 = Real(-1);
     for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>&, Real r2) {
       if (boundary(P.kind[j]) && (nearest2 < Real(0) || r2 < nearest2)) nearest2 = r2;
     });
     if (nearest2 < Real(0)) return;
     const Real reach = std::sqrt(nearest2) + prm.wall_constraint_band;
-    bool behind_all = true, any = false;
+    const Real reach2 = reach * reach;
+    // The surface i is least behind.
+    bool behind = false;
     Real exit_s = Real(0);
     Vec<D> exit_n{};
     std::uint32_t exit_j = 0;
     for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
-      if (!behind_all || !boundary(P.kind[j]) || r2 > reach * reach) return;
+      if (!boundary(P.kind[j]) || r2 > reach2) return;
       const Vec<D> g = P.boundary_normal[j];
       const Real gl = std::sqrt(norm2(g));
       if (!(gl > Real(0))) return;
       const Vec<D> n = (Real(1) / gl) * g;
       const Real s = dot(rij, n) - Real(0.5) * gl;
-      if (s >= Real(0)) {
-        behind_all = false;
-        return;
-      }
-      if (!any || s > exit_s) {
+      if (s < Real(0) && (!behind || s > exit_s)) {
         exit_s = s;
         exit_n = n;
         exit_j = j;
-        any = true;
+        behind = true;
       }
     });
-    if (!behind_all || !any) return;
+    if (!behind) return;
+    // In front of a surface that meets e's at a convex edge: outside the wall.
+    bool outside = false;
+    const Vec<D> xe = P.position[exit_j];
+    for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
+      if (outside || !boundary(P.kind[j]) || r2 > reach2) return;
+      const Vec<D> g = P.boundary_normal[j];
+      const Real gl = std::sqrt(norm2(g));
+      if (!(gl > Real(0))) return;
+      const Vec<D> n = (Real(1) / gl) * g;
+      if (dot(rij, n) - Real(0.5) * gl < Real(0)) return;
+      if (dot(xe - P.position[j], n) - Real(0.5) * gl < Real(0)) outside = true;
+    });
+    if (outside) return;
     P.position[i] = xi - exit_s * exit_n;
     const Real vn = dot(P.velocity[i] - P.velocity[exit_j], exit_n);
     if (vn < Real(0)) P.velocity[i] -= vn * exit_n;

@@ -60,6 +60,16 @@ struct GridView {
     });
     return any;
   }
+  // True if a particle other than fluid (wall, structure, buffer) may be in the cells around cell c
+  // (always true without fluid_before): cells [0, c) hold cell_start[c] - fluid_before[c] of them.
+  TURBID_HD bool boundary_near(const int* c) const {
+    if (!fluid_before) return true;
+    bool any = false;
+    for_each_cell_range(c, [&](std::uint32_t c0, std::uint32_t c1, const Vec<D>&) {
+      any = any || cell_start[c1] - fluid_before[c1] > cell_start[c0] - fluid_before[c0];
+    });
+    return any;
+  }
   // Calls f(begin, end, offset) for every contiguous range of particles in the cells around cell
   // c; offset is the image shift of those particles (zero unless the range wraps a periodic axis).
   template <class F>

@@ -115,6 +115,30 @@ TEST(FluidBehindWalls, BesideABoxsEdgeIsNotBehindItsTopFace) {
   EXPECT_NEAR(b.deepest, 0.2 * dx, 1e-6);
 }
 
+// A concave junction: a box standing on the floor (its bottom face rests on the floor's surface
+// y = 0 and is no surface). Fluid inside the box near its left face (x = 0) and above the floor's
+// surface is behind the box's face, though in front of the floor: counted, by its distance to the
+// face it is least behind. Fluid beside the box above the floor is in front of both.
+TEST(FluidBehindWalls, InsideABoxOnTheFloorIsBehindItsFace) {
+  const float dx = 0.01f;
+  Layout L;
+  for (int i = -4; i < 6; ++i)
+    for (int j = 0; j < 2; ++j) L.boundary((i + 0.5f) * dx, -(j + 0.5f) * dx, {0, (2 * j + 1) * dx, 0});  // floor
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {  // the box [0, 0.04] x [0, 0.04]: left face x = 0, top y = 0.04
+      const float x = (i + 0.5f) * dx, y = (j + 0.5f) * dx;
+      const bool left = i <= 3 - j;  // nearer the left face than the top
+      L.boundary(x, y, left ? std::array<float, 3>{-2 * x, 0, 0} : std::array<float, 3>{0, 2 * (4 * dx - y), 0});
+    }
+  L.fluid(0.3f * dx, 0.2f * dx);    // inside the box, 0.3 dx behind its left face, 0.2 dx above the floor
+  L.fluid(-0.5f * dx, 0.5f * dx);   // beside the box on the floor: in front of both
+  auto in = L.input(2 * dx);
+  in.band = 0.5 * dx;
+  const auto b = fsi::count_fluid_behind_walls(in);
+  EXPECT_EQ(b.count, 1u);
+  EXPECT_NEAR(b.deepest, 0.3 * dx, 1e-6);
+}
+
 TEST(FluidBehindWalls, NothingBeyondTheSearchRadiusCounts) {
   const float dx = 0.01f;
   Layout L;
