@@ -551,7 +551,10 @@ std::vector<std::string> check_layout(const Scene& s, const sph::Domain& domain,
       long c[2] = {0, 0};
       int n = 0;
       for (int k = 0; k < d; ++k)
-        if (k != down) c[n++] = long(std::floor(p[k] / dx)) + (n == 0 ? di : dj);
+        if (k != down) {
+          c[n] = long(std::floor(p[k] / dx)) + (n == 0 ? di : dj);
+          ++n;
+        }
       return (static_cast<long long>(c[1] & 0xffffffff) << 32) | static_cast<long long>(c[0] & 0xffffffff);
     };
     for (std::size_t i = block_first.back(); i < structure_first.back(); ++i) {

@@ -56,6 +56,7 @@ FluidBehindWalls count_fluid_behind_walls(const PenetrationInput& in) {
     return s;
   };
   std::vector<std::pair<double, std::uint32_t>> near;  // (r^2, boundary particle) within the radius
+  std::vector<std::uint32_t> behind;                    // of those, the ones whose surface it is behind
   for (std::size_t i = 0; i < in.size; ++i) {
     if (in.kind[i] != std::uint8_t(sph::Kind::fluid)) continue;
     const float* xi = in.position + i * std::size_t(d);
@@ -79,27 +80,29 @@ FluidBehindWalls count_fluid_behind_walls(const PenetrationInput& in) {
         }
     if (near.empty()) continue;
     // The rule of sph::WallConstraintPass (its comment): behind some surface within `band` of the
-    // nearest (e the least behind), and not in front of a surface that meets e's at a convex edge.
+    // nearest, and not in front of a surface that meets all of those at a convex edge.
     const double reach = std::sqrt(best) + in.band;
     const auto within = [&](double r2) { return r2 <= best || r2 <= reach * reach; };
     double s_max = -std::numeric_limits<double>::infinity();
     std::uint32_t deciding = near.front().second;
-    bool behind = false;
+    behind.clear();
     for (const auto& [r2, b] : near) {
       if (!within(r2)) continue;
       const double s = surface_distance(xi, b);
       if (std::isnan(s) || s >= 0) continue;
-      if (!behind || s > s_max) s_max = s, deciding = b;
-      behind = true;
+      if (behind.empty() || s > s_max) s_max = s, deciding = b;
+      behind.push_back(b);
     }
-    if (!behind) continue;
-    const float* xe = in.position + std::size_t(deciding) * std::size_t(d);
+    if (behind.empty()) continue;
     bool outside = false;
     for (const auto& [r2, b] : near) {
       if (outside || !within(r2)) continue;
       const double s = surface_distance(xi, b);
       if (std::isnan(s) || s < 0) continue;
-      outside = surface_distance(xe, b) < 0;  // e behind the plane of b: a convex edge
+      // A convex edge: every surface the particle is behind lies behind the plane of b.
+      outside = std::all_of(behind.begin(), behind.end(), [&](std::uint32_t e) {
+        return surface_distance(in.position + std::size_t(e) * std::size_t(d), b) < 0;
+      });
     }
     if (outside) continue;
     if (s_max < -in.tolerance) {

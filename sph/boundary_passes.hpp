@@ -329,9 +329,10 @@ struct StructureForcePass {
 //   s_b = (x_i - x_b) . n_b - |g_b| / 2,   n_b = g_b / |g_b|
 // (g_b the ghost offset, twice b's depth below the surface: boundary_normal). i is behind the wall
 // when it is behind some of those surfaces (s_b < 0; e the one it is least behind) and no surface
-// it is in front of (s_b' >= 0) meets e's at a convex edge, that is with e behind the plane of b'
-// (beside a box's side face, behind the plane of its top row, i is outside; above the floor but
-// inside a box standing on it, a concave junction, i is inside). fsi/wall_penetration.cpp counts by
+// it is in front of (s_b' >= 0) meets them at a convex edge, that is with every one of them behind
+// the plane of b' (beside a box's side face, behind the plane of its top row, i is outside; above
+// the floor but inside a box standing on it, a concave junction, i is inside; the diagonal ghost
+// offsets of a tank's edge particles are among those it is behind there, not all of them). fsi/wall_penetration.cpp counts by
 // the same rule. i is then put on e's surface, x_i -= s_e n_e, and its velocity into that wall,
 // relative to e's, removed (an inelastic stop; the tangential velocity is kept). Fluid in front of
 // the walls is untouched, so the pass changes nothing in flows that keep out of walls on their own.
@@ -359,8 +360,10 @@ struct WallConstraintPass {
     if (nearest2 < Real(0)) return;
     const Real reach = std::sqrt(nearest2) + prm.wall_constraint_band;
     const Real reach2 = reach * reach;
-    // The surface i is least behind.
-    bool behind = false;
+    // The surfaces i is behind (up to kMaxBehind of them), and the one it is least behind.
+    constexpr int kMaxBehind = 24;
+    std::uint32_t behind_j[kMaxBehind];
+    int behind = 0;
     Real exit_s = Real(0);
     Vec<D> exit_n{};
     std::uint32_t exit_j = 0;
@@ -371,17 +374,21 @@ struct WallConstraintPass {
       if (!(gl > Real(0))) return;
       const Vec<D> n = (Real(1) / gl) * g;
       const Real s = dot(rij, n) - Real(0.5) * gl;
-      if (s < Real(0) && (!behind || s > exit_s)) {
+      if (!(s < Real(0))) return;
+      if (behind == 0 || s > exit_s) {
         exit_s = s;
         exit_n = n;
         exit_j = j;
-        behind = true;
       }
+      if (behind < kMaxBehind) behind_j[behind] = j;
+      ++behind;
     });
-    if (!behind) return;
-    // In front of a surface that meets e's at a convex edge: outside the wall.
+    if (behind == 0) return;
+    const int kept = behind < kMaxBehind ? behind : kMaxBehind;
+    // In front of a surface whose plane has every surface i is behind behind it (a convex edge, as
+    // beside a box's side face below its top): outside the wall. At a concave junction some of
+    // them (the floor's, below a box standing on it) are in front of that plane.
     bool outside = false;
-    const Vec<D> xe = P.position[exit_j];
     for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
       if (outside || !boundary(P.kind[j]) || r2 > reach2) return;
       const Vec<D> g = P.boundary_normal[j];
@@ -389,7 +396,10 @@ struct WallConstraintPass {
       if (!(gl > Real(0))) return;
       const Vec<D> n = (Real(1) / gl) * g;
       if (dot(rij, n) - Real(0.5) * gl < Real(0)) return;
-      if (dot(xe - P.position[j], n) - Real(0.5) * gl < Real(0)) outside = true;
+      bool all_behind = true;
+      for (int k = 0; k < kept && all_behind; ++k)
+        all_behind = dot(P.position[behind_j[k]] - P.position[j], n) - Real(0.5) * gl < Real(0);
+      outside = all_behind;
     });
     if (outside) return;
     P.position[i] = xi - exit_s * exit_n;
