@@ -353,11 +353,17 @@ struct WallConstraintPass {
     const Vec<D> xi = P.position[i];
     int c[D] = {};
     if (G.cell_of(xi, c) && !G.boundary_near(c)) return;  // most fluid: no wall within a cell
+    // The nearest boundary particle, and whether i is behind any surface near it at all (most
+    // fluid beside a wall is in front of every one: one loop then).
     Real nearest2 = Real(-1);
-    for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>&, Real r2) {
-      if (boundary(P.kind[j]) && (nearest2 < Real(0) || r2 < nearest2)) nearest2 = r2;
+    bool behind_any = false;
+    for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
+      if (!boundary(P.kind[j])) return;
+      if (nearest2 < Real(0) || r2 < nearest2) nearest2 = r2;
+      const Vec<D> g = P.boundary_normal[j];
+      behind_any = behind_any || dot(rij, g) < Real(0.5) * norm2(g);  // s_j < 0, times |g_j|
     });
-    if (nearest2 < Real(0)) return;
+    if (!behind_any) return;
     const Real reach = std::sqrt(nearest2) + prm.wall_constraint_band;
     const Real reach2 = reach * reach;
     // The surfaces i is behind (up to kMaxBehind of them), and the one it is least behind.
