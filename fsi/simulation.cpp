@@ -739,6 +739,7 @@ sph::PhysicsParams physics_params(const Scene& scene) {
   p.wall_no_slip = scene.numerics.no_slip.value_or(p.full_stress);
   p.wall_constraint = scene.numerics.impermeable && (!scene.walls.empty() || !scene.structures.empty());
   p.wall_constraint_band = sph::Real(0.5 * scene.particle_spacing);
+  p.wall_constraint_reach = sph::Real(scene.particle_spacing);
   for (const auto& w : scene.walls) p.free_slip_walls = p.free_slip_walls || w.free_slip;
   p.body_count = int(scene.structures.size());
   p.zone_count = int(scene.open_boundaries.size());
@@ -1546,6 +1547,7 @@ FluidBehindWalls Simulation::measure_fluid_behind_walls() {
   in.radius = 2.0 * params_.smoothing_length;  // the kernel support
   in.tolerance = 0.25 * scene_.particle_spacing;  // see fsi/wall_penetration.hpp
   in.band = 0.5 * scene_.particle_spacing;
+  in.inside = scene_.particle_spacing;  // as params_.wall_constraint_reach
   for (const auto& k : body_kinematics()) {
     const Eigen::Quaterniond q(k.orientation[0], k.orientation[1], k.orientation[2], k.orientation[3]);
     const Eigen::Matrix3d R = q.normalized().toRotationMatrix();

@@ -140,6 +140,10 @@ class Simulation {
   double fluid_particle_steps_per_second() const;
   std::uint64_t fluid_particle_steps() const { return fluid_particle_steps_; }
   void restore_fluid_particle_steps(std::uint64_t n) { fluid_particle_steps_ = n; }
+  // Fluid particles impermeable walls put back on a surface, summed over the drifts of the whole
+  // run (a particle counts once per drift); 0 with `impermeable: false`.
+  std::uint64_t wall_put_backs() { return wall_put_backs_before_ + solver_->backend().wall_put_backs(); }
+  void restore_wall_put_backs(std::uint64_t n) { wall_put_backs_before_ = n; }
 
   // Output bookkeeping, saved in checkpoints so a resumed run writes the same frames.
   std::uint64_t output_index() const { return output_index_; }
@@ -200,6 +204,7 @@ class Simulation {
   std::uint64_t probes_index_ = 0;
   std::uint64_t particle_steps_ = 0;
   std::uint64_t fluid_particle_steps_ = 0;
+  std::uint64_t wall_put_backs_before_ = 0;  // from the checkpoint a run resumed from
   bool interrupted_ = false;
   // Ghost offsets at t = 0 of the wall and structure particles (ids from boundary_first_id_ on):
   // the surfaces the count of fluid behind walls measures against.

@@ -78,7 +78,7 @@ FluidBehindWalls count_fluid_behind_walls(const PenetrationInput& in) {
             best = std::min(best, r2);
           }
         }
-    if (near.empty()) continue;
+    if (near.empty() || (in.inside > 0 && best > in.inside * in.inside)) continue;
     // The rule of sph::WallConstraintPass (its comment): behind some surface within `band` of the
     // nearest, and not in front of a surface that meets all of those at a convex edge.
     const double reach = std::sqrt(best) + in.band;
@@ -99,9 +99,11 @@ FluidBehindWalls count_fluid_behind_walls(const PenetrationInput& in) {
       if (outside || !within(r2)) continue;
       const double s = surface_distance(xi, b);
       if (std::isnan(s) || s < 0) continue;
-      // A convex edge: every surface the particle is behind lies behind the plane of b.
+      // A convex edge: every surface the particle is behind lies behind the plane of b, by more
+      // than band / 2 (dx/4; the pass's margin, which tells a tank's diagonal edge plane through
+      // the next floor particle from a convex edge).
       outside = std::all_of(behind.begin(), behind.end(), [&](std::uint32_t e) {
-        return surface_distance(in.position + std::size_t(e) * std::size_t(d), b) < 0;
+        return surface_distance(in.position + std::size_t(e) * std::size_t(d), b) < -0.5 * in.band;
       });
     }
     if (outside) continue;

@@ -15,7 +15,9 @@
 // such fluid back on the surface: behind some of their surfaces (e the one it is least behind) and
 // not in front of a surface that meets e's at a convex edge (e behind that surface's plane). Beside a
 // box's side face, behind the plane of its top row, a particle is outside; inside a box standing on
-// the floor, above the floor's surface, it is inside (a concave junction).
+// the floor, above the floor's surface, it is inside (a concave junction). A particle farther than
+// `inside` (dx) from every boundary particle is inside no wall (beside a box's corner it may see
+// only the plane of the top row, and be below it).
 #pragma once
 #include <array>
 #include <cstddef>
@@ -48,6 +50,7 @@ struct PenetrationInput {
   double radius = 0;     // search radius for the nearest boundary particle [m] (the kernel support)
   double tolerance = 0;  // counted when more than this behind the surface [m]
   double band = 0;       // boundary particles within the nearest distance + band all decide [m]
+  double inside = 0;     // a fluid particle farther than this from its nearest is inside no wall [m] (0: no bound)
 };
 
 FluidBehindWalls count_fluid_behind_walls(const PenetrationInput& in);

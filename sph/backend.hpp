@@ -52,6 +52,9 @@ class Backend {
   virtual void compute_forces() = 0;        // pressure from density, momentum
   virtual void kick(double half_dt) = 0;    // v += half_dt a (fluid)
   virtual void drift(double dt) = 0;        // x += dt v (fluid); rho += dt drho/dt (all)
+  // Fluid particles the drift put back on a wall's surface since bind (impermeable walls; one per
+  // particle and drift), a diagnostic of how much the walls' pressure alone would have let through.
+  virtual std::uint64_t wall_put_backs() { return 0; }
   // After the drift, with open boundaries: particles crossing buffer-zone planes (open_boundary.hpp).
   virtual OpenBoundaryCounts update_open_boundaries() = 0;
   virtual StepStats stats() = 0;

@@ -24,4 +24,14 @@ namespace turbid::sph {
 // reductions that must conserve (mass, momentum, energy) accumulate in double.
 using Real = float;
 
+// Adds one to a counter shared by every thread of a pass (a tally of rare events, not a sum on
+// which results depend: its order does not matter).
+TURBID_HD inline void count_one(unsigned long long* counter) {
+#if defined(__CUDA_ARCH__)
+  atomicAdd(counter, 1ull);
+#else
+  __atomic_fetch_add(counter, 1ull, __ATOMIC_RELAXED);
+#endif
+}
+
 }  // namespace turbid::sph

@@ -78,6 +78,11 @@ struct PhysicsParams {
   // every wall or structure particle near it is put back on that surface (needs boundary_normal).
   bool wall_constraint = false;
   Real wall_constraint_band = Real(0);  // boundary particles within nearest + band decide [m] (dx / 2)
+  // Farther than this from every boundary particle a fluid particle is inside no wall [m] (dx: a
+  // point behind a surface of a wall built on the lattice is within sqrt(D)/2 dx of one of its
+  // particles). Without it a particle beside a box's corner, 4 dx off, saw only the top row's
+  // plane and was put on it.
+  Real wall_constraint_reach = Real(0);
   Real mdbc_wet_share = Real(0.5);  // mDBC: a ghost node with less fluid than this share of its support is dry
   // Some walls are free-slip: their particles carry the `free_slip` field, and the viscous terms
   // (laminar viscosity, velocity gradient) leave them out.

@@ -200,7 +200,7 @@ void check_run_state(const nlohmann::json& state, const fs::path& file) {
                       {"inflow", false, true},         {"outflow", false, true},        {"splits", false, true},
                       {"daughters", false, true},      {"splits_refused", false, true},
                       {"smallest_smoothing_length", false, false}, {"checkpoint_every", false, false},
-                      {"fluid_particle_steps", false, true}};
+                      {"fluid_particle_steps", false, true}, {"wall_put_backs", false, true}};
   for (const Key& k : keys) {
     if (!state.contains(k.name)) {
       if (k.required) bad(file, "'state' has no '" + std::string(k.name) + "'");
@@ -392,6 +392,7 @@ class Writers final : public fsi::Observer {
     state["checkpoint_index"] = sim.checkpoint_index();
     state["particle_steps"] = sim.particle_steps();
     state["fluid_particle_steps"] = sim.fluid_particle_steps();
+    state["wall_put_backs"] = sim.wall_put_backs();
     state["inflow"] = sim.inflow();
     state["outflow"] = sim.outflow();
     if (!sim.scene().transitions.empty()) {
@@ -848,6 +849,7 @@ nlohmann::json run_scene(const RunRequest& request) {
                  state.value("wall_seconds", 0.0));
       sim.restore_open_boundary_counts(state.value("inflow", std::uint64_t(0)), state.value("outflow", std::uint64_t(0)));
       sim.restore_fluid_particle_steps(state.value("fluid_particle_steps", std::uint64_t(0)));
+      sim.restore_wall_put_backs(state.value("wall_put_backs", std::uint64_t(0)));
       sph::SplitCounts splits;
       splits.splits = state.value("splits", std::size_t(0));
       splits.daughters = state.value("daughters", std::size_t(0));
@@ -893,6 +895,9 @@ nlohmann::json run_scene(const RunRequest& request) {
   report["fluid_behind_walls"] = sim.fluid_behind_walls().count;
   report["fluid_behind_walls_deepest_m"] = sim.fluid_behind_walls().deepest;
   report["fluid_behind_walls_max"] = writers.most_behind_walls();
+  // What impermeable walls did to get there: fluid particles put back on a wall's surface, summed
+  // over every drift (a particle counts once per drift).
+  report["fluid_put_back_on_walls"] = sim.wall_put_backs();
   if (!scene.open_boundaries.empty()) {
     report["buffer_particles"] = sim.summary().buffer_particles;
     report["inflow_particles"] = sim.inflow();

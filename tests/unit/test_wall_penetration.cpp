@@ -148,6 +148,47 @@ TEST(FluidBehindWalls, NothingBeyondTheSearchRadiusCounts) {
   EXPECT_EQ(fsi::count_fluid_behind_walls(L.input(4 * dx)).count, 1u);
 }
 
+// A fluid particle beside a box's corner, 4 dx off, sees only the top row's particle within the
+// search radius and stands below its plane: it is inside no wall, for it is farther than dx
+// (`inside`) from every boundary particle (a point behind a surface built on the lattice is within
+// sqrt(d)/2 dx of one). Seen in the 3D dam break with a box (docs/validation.md W).
+TEST(FluidBehindWalls, FarFromEveryWallParticleIsInsideNone) {
+  const float dx = 0.01f;
+  Layout L;
+  L.boundary(0, 0, {0, dx, 0});     // the top row's corner particle; surface y = dx/2
+  L.fluid(-3.9f * dx, -0.5f * dx);  // 1 dx below that plane, 3.93 dx from the particle
+  auto in = L.input(4 * dx);
+  EXPECT_EQ(fsi::count_fluid_behind_walls(in).count, 1u) << "no bound: behind the plane";
+  in.inside = dx;
+  EXPECT_EQ(fsi::count_fluid_behind_walls(in).count, 0u);
+  L.fluid(0.3f * dx, -0.4f * dx);  // 0.5 dx from it and behind its surface: inside
+  in = L.input(4 * dx);
+  in.inside = dx;
+  EXPECT_EQ(fsi::count_fluid_behind_walls(in).count, 1u);
+}
+
+// In a tank's floor-wall edge the edge particle's ghost offset is diagonal; its plane passes through
+// the floor particle next to it. A fluid particle in front of that plane but below the floor's
+// surface is in a concave corner, not beside a convex edge: it is behind the floor. Reference: the
+// geometry (end wall x < 0, floor y < 0, surfaces x = 0 and y = 0); seen in the 3D box case.
+TEST(FluidBehindWalls, ATanksDiagonalEdgePlaneIsNoConvexEdge) {
+  const float dx = 0.01f;
+  Layout L;
+  L.boundary(-0.5f * dx, -0.5f * dx, {dx, dx, 0});  // the edge particle: ghost across the corner
+  for (int i = 0; i < 6; ++i) {
+    L.boundary((i + 0.5f) * dx, -0.5f * dx, {0, dx, 0});       // floor, first layer
+    L.boundary((i + 0.5f) * dx, -1.5f * dx, {0, 3 * dx, 0});   // second layer
+    L.boundary(-0.5f * dx, (i + 0.5f) * dx, {dx, 0, 0});       // end wall
+    L.boundary(-1.5f * dx, (i + 0.5f) * dx, {3 * dx, 0, 0});
+  }
+  L.fluid(0.25f * dx, -0.2f * dx);  // 0.2 dx below the floor's surface, in front of the diagonal plane
+  auto in = L.input(2 * dx);
+  in.band = 0.5 * dx;
+  const auto b = fsi::count_fluid_behind_walls(in);
+  EXPECT_EQ(b.count, 1u);
+  EXPECT_NEAR(b.deepest, 0.2 * dx, 1e-6);
+}
+
 // A 2D tank 1 x 0.6 m at dx = 0.02 m, water 0.3 m deep; `numerics` (YAML lines) and `rest` follow.
 std::string tank(const std::string& numerics, const std::string& rest) {
   return R"(name: tank
@@ -222,6 +263,7 @@ TEST(ImpermeableWalls, FluidPastTheFloorIsPutBackOnItsSurface) {
   struct Result {
     float y_moved, v_moved, u_moved;  // the particle pushed below the floor
     std::vector<float> others;        // every other fluid particle's position after the steps
+    std::uint64_t put_backs;          // the run's count of particles put back on a surface
   };
   auto run = [](bool impermeable) {
     const std::string yaml =
@@ -245,6 +287,7 @@ TEST(ImpermeableWalls, FluidPastTheFloorIsPutBackOnItsSurface) {
       }
     sim.step(1e-4);
     Result r{};
+    r.put_backs = sim.wall_put_backs();
     for (std::size_t i = 0; i < st.size(); ++i) {
       if (kind[i] != std::uint8_t(Kind::fluid)) continue;
       if (id[i] == moved) {
@@ -264,6 +307,45 @@ TEST(ImpermeableWalls, FluidPastTheFloorIsPutBackOnItsSurface) {
   EXPECT_LT(off.y_moved, -0.006f) << "without the pass it goes on down: " << off.y_moved;
   EXPECT_LT(off.v_moved, 0.0f);
   EXPECT_EQ(on.others, off.others) << "fluid in front of the walls is not touched";
+  EXPECT_EQ(on.put_backs, 1u) << "the one particle, counted once";
+  EXPECT_EQ(off.put_backs, 0u);
+}
+
+// In a concave corner (the floor meeting the tank's end wall) a particle behind both surfaces is
+// put in front of both: pushed out of the one it is least behind alone it would stay below the
+// floor. Reference: the surfaces x = 0 and y = 0 of the tank's walls; "on the surface" to the
+// pass's on-surface margin (1e-3 of its band, dx/2: 1e-5 m) and float rounding.
+TEST(ImpermeableWalls, FluidInACornerIsPutInFrontOfBothWalls) {
+  const std::string yaml = tank("  boundary: {type: dbc}", "time: {end: 0.001}\ngravity: [0, 0]\noutput: {every: 0, vtk: false}\n");
+  fsi::Simulation sim(test::scene_of(yaml), test::cpu());
+  sim.start();
+  auto& st = sim.store();
+  auto* x = static_cast<float*>(st.raw(sim.fields().position));
+  auto* v = static_cast<float*>(st.raw(sim.fields().velocity));
+  const auto* kind = st.data<std::uint8_t>(sim.fields().kind);
+  std::size_t moved = st.size();
+  for (std::size_t i = 0; i < st.size(); ++i)
+    if (kind[i] == std::uint8_t(Kind::fluid) && x[2 * i] < 0.011f && x[2 * i + 1] < 0.011f) {
+      x[2 * i] = -0.002f;      // 0.1 dx behind the end wall's surface (x = 0)
+      x[2 * i + 1] = -0.006f;  // and 0.3 dx below the floor's (y = 0), heading into the corner
+      v[2 * i] = -0.5f;
+      v[2 * i + 1] = -1.0f;
+      moved = i;
+      break;
+    }
+  ASSERT_LT(moved, st.size());
+  const auto* id = st.data<std::uint32_t>(sim.fields().id);
+  const std::uint32_t who = id[moved];
+  sim.step(1e-4);
+  EXPECT_EQ(sim.wall_put_backs(), 1u) << "one particle in one drift, however many pushes";
+  for (std::size_t i = 0; i < st.size(); ++i)
+    if (id[i] == who) {
+      EXPECT_GE(x[2 * i], -1.1e-5f) << "in front of the end wall: " << x[2 * i] << ", " << x[2 * i + 1] << " v " << v[2 * i] << ", " << v[2 * i + 1];
+      EXPECT_GE(x[2 * i + 1], -1.1e-5f) << "in front of the floor";
+      EXPECT_LT(x[2 * i] + x[2 * i + 1], 0.005f) << "put on the surfaces, not thrown into the fluid";
+      EXPECT_GE(v[2 * i], 0.0f) << "no velocity into the end wall";
+      EXPECT_GE(v[2 * i + 1], 0.0f) << "no velocity into the floor";
+    }
 }
 
 }  // namespace

@@ -40,6 +40,7 @@ class CpuBackend final : public Backend {
     store_ = &store;
     ids_ = ids;
     params_ = params;
+    wall_put_backs_ = 0;
     omp_set_num_threads(threads_);
     layout_ = GridLayout::make(domain, params.dimensions, 2.0 * params.smoothing_length * max_h_ratio());
     cell_count_ = layout_.cell_count;
@@ -72,6 +73,7 @@ class CpuBackend final : public Backend {
     if (params_.dimensions == 2) drift_impl<2>(Real(dt));
     else drift_impl<3>(Real(dt));
   }
+  std::uint64_t wall_put_backs() override { return wall_put_backs_; }
 
   OpenBoundaryCounts update_open_boundaries() override {
     const OpenBoundaryCounts c = sph::update_open_boundaries(*store_, ids_, params_);
@@ -544,7 +546,8 @@ class CpuBackend final : public Backend {
     parallel_for(std::uint32_t(store_->size()),
                  DriftPass<D>{view<D>(), dt, params_.materials[params_.wall_material].eos.no_tension_density(), params_});
     if (params_.wall_constraint)
-      parallel_for(std::uint32_t(store_->size()), WallConstraintPass<D>{view<D>(), grid<D>(), params_, list(false)});
+      parallel_for(std::uint32_t(store_->size()),
+                   WallConstraintPass<D>{view<D>(), grid<D>(), params_, list(false), &wall_put_backs_});
   }
 
   template <int D>
@@ -620,6 +623,7 @@ class CpuBackend final : public Backend {
   }
 
   int threads_;
+  unsigned long long wall_put_backs_ = 0;
   ParticleStore* store_ = nullptr;
   FieldIds ids_;
   PhysicsParams params_;

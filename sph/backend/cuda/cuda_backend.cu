@@ -280,6 +280,8 @@ class CudaBackend final : public Backend {
     TURBID_CUDA_CHECK(cudaMemset(cell_start_.get(), 0, cell_start_.bytes()));
     fluid_before_.allocate((cell_count_ + 1) * sizeof(std::uint32_t));
     TURBID_CUDA_CHECK(cudaMemset(fluid_before_.get(), 0, fluid_before_.bytes()));
+    put_backs_.allocate(sizeof(unsigned long long));
+    TURBID_CUDA_CHECK(cudaMemset(put_backs_.get(), 0, put_backs_.bytes()));
     allocate_fields();
     upload();
   }
@@ -308,10 +310,18 @@ class CudaBackend final : public Backend {
     if (params_.dimensions == 2) launch("DriftPass<2>", n_, DriftPass<2>{view<2>(), Real(dt), wall_rho_min, params_});
     else launch("DriftPass<3>", n_, DriftPass<3>{view<3>(), Real(dt), wall_rho_min, params_});
     if (!params_.wall_constraint) return;
+    auto* put_backs = put_backs_.as<unsigned long long>();
     if (params_.dimensions == 2)
-      launch("WallConstraintPass<2>", n_, WallConstraintPass<2>{view<2>(), grid<2>(), params_, NeighbourList{}});
+      launch("WallConstraintPass<2>", n_, WallConstraintPass<2>{view<2>(), grid<2>(), params_, NeighbourList{}, put_backs});
     else
-      launch("WallConstraintPass<3>", n_, WallConstraintPass<3>{view<3>(), grid<3>(), params_, NeighbourList{}});
+      launch("WallConstraintPass<3>", n_, WallConstraintPass<3>{view<3>(), grid<3>(), params_, NeighbourList{}, put_backs});
+  }
+
+  std::uint64_t wall_put_backs() override {
+    unsigned long long n = 0;
+    if (put_backs_.get())
+      TURBID_CUDA_CHECK(cudaMemcpy(&n, put_backs_.get(), sizeof(n), cudaMemcpyDeviceToHost));
+    return n;
   }
 
   // Conversions at open boundaries run on the host (few particles change; the store is copied
@@ -756,6 +766,7 @@ class CudaBackend final : public Backend {
   DeviceBuffer scratch_;              // gather target, capacity x widest field
   DeviceBuffer cell_start_, keys_in_, keys_out_, values_in_, values_out_;
   DeviceBuffer fluid_before_;  // cell_count + 1: fluid particles in the cells before each cell
+  DeviceBuffer put_backs_;     // one counter: WallConstraintPass's put-backs since bind
   DeviceBuffer reduce_in_, result_, temp_;
   DeviceBuffer split_slots_, split_rule_, split_first_, split_tally_;  // splitting only, from the first split
   DeviceBuffer relax_zone_, relax_shift_, relax_moment_;  // relaxation after a split, from the first one
