@@ -247,16 +247,17 @@ double evaluate(const Scene& scene, const ProbeSpec& probe, const sph::ParticleS
 
 }  // namespace
 
-const char* probe_unit(ProbeSpec::Type t) {
+const char* probe_unit(ProbeSpec::Type t, int dimensions) {
+  const bool two_d = dimensions == 2;
   switch (t) {
     case ProbeSpec::Type::front_position: return "m";
     case ProbeSpec::Type::pressure: return "Pa";
     case ProbeSpec::Type::max_speed: return "m/s";
-    case ProbeSpec::Type::kinetic_energy: return "J";
-    case ProbeSpec::Type::fluid_particles: return "1";
+    case ProbeSpec::Type::kinetic_energy: return two_d ? "J/m" : "J";
+    case ProbeSpec::Type::fluid_particles: return "-";
     case ProbeSpec::Type::surface_elevation: return "m";
     case ProbeSpec::Type::highest_particle: return "m";
-    case ProbeSpec::Type::material_mass: return "kg";
+    case ProbeSpec::Type::material_mass: return two_d ? "kg/m" : "kg";
   }
   return "";
 }

@@ -13,7 +13,7 @@ namespace turbid::fsi {
 std::vector<double> evaluate_probes(const Scene& scene, const sph::ParticleStore& store, const sph::FieldIds& ids,
                                     const sph::PhysicsParams& params);
 
-// Unit of each probe type, for documentation and headers.
-const char* probe_unit(ProbeSpec::Type t);
+// Unit of each probe type (probes.csv headers): SI, per metre of depth in 2D for the extensive ones.
+const char* probe_unit(ProbeSpec::Type t, int dimensions);
 
 }  // namespace turbid::fsi

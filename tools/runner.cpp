@@ -17,6 +17,7 @@
 
 #include "fsi/bullet_world.hpp"
 #include "fsi/forces.hpp"
+#include "fsi/probes.hpp"
 #include "fsi/simulation.hpp"
 #include "tools/checkpoint.hpp"
 #include "tools/csv_writer.hpp"
@@ -311,8 +312,10 @@ class Writers final : public fsi::Observer {
   Writers(const fs::path& out, const fsi::Scene& scene, std::optional<double> resume_time, bool progress)
       : out_(out), progress_(progress), tty_(isatty(fileno(stderr)) != 0) {
     std::vector<std::string> names;
-    for (const auto& p : scene.probes) names.push_back(p.name);
-    probes_.emplace(out / "probes.csv", names, resume_time);
+    // Each column names its unit, as forces.csv does ("front [m]", "p1 [Pa]").
+    for (const auto& p : scene.probes)
+      names.push_back(p.name + " [" + fsi::probe_unit(p.type, scene.dimensions) + "]");
+    probes_.emplace(out / "probes.csv", names, resume_time, "time [s]");
     if (!scene.structures.empty()) forces_.emplace(out / "forces.csv", fsi::force_columns(scene), resume_time, "time [s]");
     if (scene.output.vtk) {
       vtk_.emplace(out, scene.dimensions);

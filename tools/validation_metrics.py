@@ -56,7 +56,8 @@ HYDROSTATIC_PROBES = {"p_mid": 0.5, "p_bottom": 0.1}  # probe name -> height y [
 
 def read_csv(path):
     """Reads a numeric CSV with a header line; lines starting with '#' are skipped.
-    Returns {column name: list of floats}."""
+    Returns {column name: list of floats}; each column also under its name without the unit
+    ("front [m]" as "front"), unless that name is taken."""
     columns = None
     names = []
     with open(path) as f:
@@ -73,6 +74,10 @@ def read_csv(path):
                 columns[n].append(float(c))
     if columns is None:
         raise ValueError(f"{path}: no header line")
+    for n in names:
+        bare = n.split(" [")[0]
+        if bare and bare not in columns:
+            columns[bare] = columns[n]
     return columns
 
 

@@ -61,6 +61,12 @@ inline std::map<std::string, std::vector<double>> read_csv(const std::filesystem
     }
     for (std::size_t k = 0; k < names.size() && k < cells.size(); ++k) columns[names[k]].push_back(std::stod(cells[k]));
   }
+  // Each column also under its name without the unit ("front [m]" as "front"), unless taken.
+  for (const std::string& n : names) {
+    const std::size_t unit = n.find(" [");
+    if (unit != std::string::npos && unit > 0 && !columns.count(n.substr(0, unit)))
+      columns[n.substr(0, unit)] = columns[n];
+  }
   return columns;
 }
 
