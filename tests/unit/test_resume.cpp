@@ -176,6 +176,19 @@ ResumeRuns check_resume(const std::string& scene_text) {
 
 TEST(CheckpointResume, ResumedRunIsBitIdenticalToUninterruptedRun) { check_resume(kScene); }
 
+// Probes on their own schedule (issue #25 item 4): the resumed run picks the schedule up from the
+// checkpoint's time, so probes.csv has the same rows, byte for byte, every 2.5 ms and every step.
+TEST(CheckpointResume, ResumedRunWithProbesOnTheirOwnScheduleIsBitIdentical) {
+  for (const char* every : {"0.0025", "step"}) {
+    std::string scene = kScene;
+    const std::string out = "output: {every: 0.01, vtk: true}";
+    ASSERT_NE(scene.find(out), std::string::npos);
+    scene.replace(scene.find(out), out.size(), "output: {every: 0.01, vtk: true, probes_every: " + std::string(every) + "}");
+    SCOPED_TRACE(every);
+    check_resume(scene);
+  }
+}
+
 // With particle shifting the next drift uses the shifting velocity of the last force pass, which
 // the checkpoint must therefore hold (like the acceleration).
 TEST(CheckpointResume, ResumedRunWithShiftingIsBitIdentical) {
