@@ -349,6 +349,17 @@ struct WallConstraintPass {
     return k == std::uint8_t(Kind::wall) || k == std::uint8_t(Kind::structure);
   }
 
+  // The surface of boundary particle j: unit normal n (its ghost offset's direction) and half the
+  // offset's length (the surface lies there in front of x_j). False without an offset.
+  TURBID_HD bool surface(std::uint32_t j, Vec<D>& n, Real& half) const {
+    const Vec<D> g = P.boundary_normal[j];
+    const Real gl = std::sqrt(norm2(g));
+    if (!(gl > Real(0))) return false;
+    n = (Real(1) / gl) * g;
+    half = Real(0.5) * gl;
+    return true;
+  }
+
   TURBID_HD void operator()(std::uint32_t i) const {
     if (P.kind[i] != std::uint8_t(Kind::fluid)) return;
     int c[D] = {};
@@ -393,12 +404,10 @@ struct WallConstraintPass {
     Vec<D> exit_n{};
     std::uint32_t exit_j = 0;
     for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
-      if (!boundary(P.kind[j]) || r2 > reach2) return;
-      const Vec<D> g = P.boundary_normal[j];
-      const Real gl = std::sqrt(norm2(g));
-      if (!(gl > Real(0))) return;
-      const Vec<D> n = (Real(1) / gl) * g;
-      const Real s = dot(rij, n) - Real(0.5) * gl;
+      Vec<D> n;
+      Real half;
+      if (!boundary(P.kind[j]) || r2 > reach2 || !surface(j, n, half)) return;
+      const Real s = dot(rij, n) - half;
       if (!(s < -on_surface)) return;
       if (behind == 0 || s > exit_s) {
         exit_s = s;
@@ -419,15 +428,13 @@ struct WallConstraintPass {
     const Real edge_margin = Real(0.5) * prm.wall_constraint_band;
     bool outside = false;
     for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
-      if (outside || !boundary(P.kind[j]) || r2 > reach2) return;
-      const Vec<D> g = P.boundary_normal[j];
-      const Real gl = std::sqrt(norm2(g));
-      if (!(gl > Real(0))) return;
-      const Vec<D> n = (Real(1) / gl) * g;
-      if (dot(rij, n) - Real(0.5) * gl < -on_surface) return;
+      Vec<D> n;
+      Real half;
+      if (outside || !boundary(P.kind[j]) || r2 > reach2 || !surface(j, n, half)) return;
+      if (dot(rij, n) - half < -on_surface) return;
       bool all_behind = true;
       for (int k = 0; k < kept && all_behind; ++k)
-        all_behind = dot(P.position[behind_j[k]] - P.position[j], n) - Real(0.5) * gl < -edge_margin;
+        all_behind = dot(P.position[behind_j[k]] - P.position[j], n) - half < -edge_margin;
       outside = all_behind;
     });
     if (outside) return false;
