@@ -259,6 +259,31 @@ TEST(FluidBehindWalls, MoreThanTheScenesLimitStopsTheRunAtItsLine) {
 // (signed distance 0, to float rounding of positions of O(1) m: 1e-6 m) and its velocity into the
 // wall removed; its tangential velocity is the kick's alone; fluid in front of every surface moves
 // exactly as without the pass (bit for bit).
+// A still 2D tank (no gravity) with walls of `boundary` (a numerics line), started; then the first
+// fluid particle of the bottom row with x in [x_lo, x_hi] is moved to `at` with velocity `vel`.
+// Returns its id.
+std::uint32_t move_one(fsi::Simulation& sim, float x_lo, float x_hi, std::array<float, 2> at,
+                       std::array<float, 2> vel) {
+  sim.start();
+  auto& st = sim.store();
+  auto* x = static_cast<float*>(st.raw(sim.fields().position));
+  auto* v = static_cast<float*>(st.raw(sim.fields().velocity));
+  const auto* kind = st.data<std::uint8_t>(sim.fields().kind);
+  const auto* id = st.data<std::uint32_t>(sim.fields().id);
+  for (std::size_t i = 0; i < st.size(); ++i)
+    if (kind[i] == std::uint8_t(Kind::fluid) && x[2 * i + 1] < 0.011f && x[2 * i] >= x_lo && x[2 * i] <= x_hi) {
+      x[2 * i] = at[0], x[2 * i + 1] = at[1];
+      v[2 * i] = vel[0], v[2 * i + 1] = vel[1];
+      return id[i];
+    }
+  ADD_FAILURE() << "no bottom-row fluid particle with x in [" << x_lo << ", " << x_hi << "]";
+  return std::uint32_t(-1);
+}
+
+std::string still_tank(const std::string& boundary) {
+  return tank("  boundary: " + boundary, "time: {end: 0.001}\ngravity: [0, 0]\noutput: {every: 0, vtk: false}\n");
+}
+
 TEST(ImpermeableWalls, FluidPastTheFloorIsPutBackOnItsSurface) {
   struct Result {
     float y_moved, v_moved, u_moved;  // the particle pushed below the floor
@@ -266,26 +291,17 @@ TEST(ImpermeableWalls, FluidPastTheFloorIsPutBackOnItsSurface) {
     std::uint64_t put_backs;          // the run's count of particles put back on a surface
   };
   auto run = [](bool impermeable) {
-    const std::string yaml =
-        tank(std::string("  boundary: {type: dbc, impermeable: ") + (impermeable ? "true" : "false") + "}",
-             "time: {end: 0.001}\ngravity: [0, 0]\noutput: {every: 0, vtk: false}\n");
-    fsi::Simulation sim(test::scene_of(yaml), test::cpu());
-    sim.start();
-    auto& st = sim.store();
-    auto* x = static_cast<float*>(st.raw(sim.fields().position));
-    auto* v = static_cast<float*>(st.raw(sim.fields().velocity));
+    fsi::Simulation sim(test::scene_of(still_tank(std::string("{type: dbc, impermeable: ") +
+                                                  (impermeable ? "true" : "false") + "}")),
+                        test::cpu());
+    // 0.3 dx below the floor's surface (y = 0), heading down and along.
+    const std::uint32_t moved = move_one(sim, 0.4f, 1.0f, {0.41f, -0.006f}, {0.5f, -1.0f});
+    sim.step(1e-4);
+    const auto& st = sim.store();
+    const auto* x = static_cast<const float*>(st.raw(sim.fields().position));
+    const auto* v = static_cast<const float*>(st.raw(sim.fields().velocity));
     const auto* kind = st.data<std::uint8_t>(sim.fields().kind);
     const auto* id = st.data<std::uint32_t>(sim.fields().id);
-    std::uint32_t moved = 0;
-    for (std::size_t i = 0; i < st.size(); ++i)
-      if (kind[i] == std::uint8_t(Kind::fluid) && x[2 * i + 1] < 0.011f && x[2 * i] > 0.4f) {
-        x[2 * i + 1] = -0.006f;  // 0.3 dx below the floor's surface (y = 0), heading down and along
-        v[2 * i] = 0.5f;
-        v[2 * i + 1] = -1.0f;
-        moved = id[i];
-        break;
-      }
-    sim.step(1e-4);
     Result r{};
     r.put_backs = sim.wall_put_backs();
     for (std::size_t i = 0; i < st.size(); ++i) {
@@ -316,31 +332,19 @@ TEST(ImpermeableWalls, FluidPastTheFloorIsPutBackOnItsSurface) {
 // floor. Reference: the surfaces x = 0 and y = 0 of the tank's walls; "on the surface" to the
 // pass's on-surface margin (1e-3 of its band, dx/2: 1e-5 m) and float rounding.
 TEST(ImpermeableWalls, FluidInACornerIsPutInFrontOfBothWalls) {
-  const std::string yaml = tank("  boundary: {type: dbc}", "time: {end: 0.001}\ngravity: [0, 0]\noutput: {every: 0, vtk: false}\n");
-  fsi::Simulation sim(test::scene_of(yaml), test::cpu());
-  sim.start();
-  auto& st = sim.store();
-  auto* x = static_cast<float*>(st.raw(sim.fields().position));
-  auto* v = static_cast<float*>(st.raw(sim.fields().velocity));
-  const auto* kind = st.data<std::uint8_t>(sim.fields().kind);
-  std::size_t moved = st.size();
-  for (std::size_t i = 0; i < st.size(); ++i)
-    if (kind[i] == std::uint8_t(Kind::fluid) && x[2 * i] < 0.011f && x[2 * i + 1] < 0.011f) {
-      x[2 * i] = -0.002f;      // 0.1 dx behind the end wall's surface (x = 0)
-      x[2 * i + 1] = -0.006f;  // and 0.3 dx below the floor's (y = 0), heading into the corner
-      v[2 * i] = -0.5f;
-      v[2 * i + 1] = -1.0f;
-      moved = i;
-      break;
-    }
-  ASSERT_LT(moved, st.size());
-  const auto* id = st.data<std::uint32_t>(sim.fields().id);
-  const std::uint32_t who = id[moved];
+  fsi::Simulation sim(test::scene_of(still_tank("{type: dbc}")), test::cpu());
+  // 0.1 dx behind the end wall's surface (x = 0) and 0.3 dx below the floor's (y = 0), heading
+  // into the corner.
+  const std::uint32_t who = move_one(sim, 0.0f, 0.011f, {-0.002f, -0.006f}, {-0.5f, -1.0f});
   sim.step(1e-4);
   EXPECT_EQ(sim.wall_put_backs(), 1u) << "one particle in one drift, however many pushes";
+  const auto& st = sim.store();
+  const auto* x = static_cast<const float*>(st.raw(sim.fields().position));
+  const auto* v = static_cast<const float*>(st.raw(sim.fields().velocity));
+  const auto* id = st.data<std::uint32_t>(sim.fields().id);
   for (std::size_t i = 0; i < st.size(); ++i)
     if (id[i] == who) {
-      EXPECT_GE(x[2 * i], -1.1e-5f) << "in front of the end wall: " << x[2 * i] << ", " << x[2 * i + 1] << " v " << v[2 * i] << ", " << v[2 * i + 1];
+      EXPECT_GE(x[2 * i], -1.1e-5f) << "in front of the end wall: " << x[2 * i] << ", " << x[2 * i + 1];
       EXPECT_GE(x[2 * i + 1], -1.1e-5f) << "in front of the floor";
       EXPECT_LT(x[2 * i] + x[2 * i + 1], 0.005f) << "put on the surfaces, not thrown into the fluid";
       EXPECT_GE(v[2 * i], 0.0f) << "no velocity into the end wall";
