@@ -301,6 +301,11 @@ struct NumericsSpec {
   // Walls and structures show the viscous terms the fluid's velocity mirrored at their ghost nodes
   // (no-slip at the wall surface); unset: yes where a material has the full viscous stress.
   std::optional<bool> no_slip;
+  // Wall function (sph::PhysicsParams::wall_function): the log law's wall shear for fluid sliding
+  // along walls and structures, with the walls' equivalent sand roughness k_s [m] (0: smooth).
+  bool wall_function = false;
+  double wall_roughness = 0;
+  SourceLocation wall_function_where;
   // Fluid that crossed a wall or structure surface is put back on it after each drift
   // (sph::WallConstraintPass); `boundary: {impermeable: false}` leaves walls to their pressure alone.
   bool impermeable = true;

@@ -737,6 +737,17 @@ sph::PhysicsParams physics_params(const Scene& scene) {
   // kink into the profile at the wall, the gradients average it away and the wall shear comes out
   // at about half (a yield-stress layer slid on DBC walls); by default its walls mirror the fluid.
   p.wall_no_slip = scene.numerics.no_slip.value_or(p.full_stress);
+  // Wall function (docs/choices.md, "Wall friction"): y below a tenth of the spacing is held there.
+  p.wall_function = scene.numerics.wall_function;
+  p.wall_roughness_length = sph::Real(scene.numerics.wall_roughness / 30.0);
+  p.wall_function_min_distance = sph::Real(0.1 * scene.particle_spacing);
+  if (p.wall_function && p.implicit_viscosity) {
+    const auto& w = scene.numerics.wall_function_where;
+    throw std::invalid_argument(w.file + ":" + std::to_string(w.line) + ":" + std::to_string(w.column) +
+                                ": error: 'wall_function' does not combine with implicitly integrated viscosity "
+                                "(a non-Newtonian material, or 'integration: implicit'), whose update holds the "
+                                "wall's viscous terms; use 'integration: explicit' or leave 'wall_function' out");
+  }
   p.wall_constraint = scene.numerics.impermeable && (!scene.walls.empty() || !scene.structures.empty());
   p.wall_constraint_band = sph::Real(0.5 * scene.particle_spacing);
   p.wall_constraint_reach = sph::Real(scene.particle_spacing);

@@ -61,6 +61,33 @@ TURBID_HD inline Real artificial_viscosity(Real alpha, Real h, Real c_mean, Real
   return m_j * alpha * c_mean * h * vij_dot_rij * F / ((r2 + eta2) * rho_mean);
 }
 
+// Wall function (docs/choices.md, "Wall friction"): the squared friction velocity u*^2 = tau_w / rho of a wall
+// under fluid sliding at tangential speed u_t (relative to the wall) at distance y from its
+// surface, kinematic viscosity nu, roughness length z_r = k_s / 30 (0: hydraulically smooth).
+// The larger of the viscous sublayer's u*^2 = nu u_t / y and the log law's
+//   u_t / u* = ln(y / z0) / kappa,  z0 = nu / (E u*) + z_r   (kappa = 0.41, E = 9.8),
+// which meet near y+ = 11 for a smooth wall and give u+ = ln(E y+) / kappa above it. The log law
+// is solved by fixed-point iteration (the log's argument varies slowly: 6 iterations settle it to
+// 1e-4 relative for 11 < y+ < 1e5); ln(y / z0) is held at 1 or more, where the law is invalid
+// (y within the roughness) and the sublayer or a u+ of 1 / kappa bounds the stress.
+TURBID_HD inline Real wall_friction_velocity2(Real u_t, Real y, Real nu, Real z_r) {
+  constexpr Real kappa = Real(0.41);
+  constexpr Real E = Real(9.8);
+  const Real laminar = nu * u_t / y;
+  if (u_t <= Real(0)) return Real(0);
+  // Start from u+ = 20, a typical value (and a positive one where nu = 0).
+  Real us = std::sqrt(laminar);
+  us = us > Real(0.05) * u_t ? us : Real(0.05) * u_t;
+  for (int it = 0; it < 6; ++it) {
+    const Real z0 = nu / (E * us) + z_r;
+    Real l = std::log(y / z0);
+    l = l < Real(1) ? Real(1) : l;
+    us = kappa * u_t / l;
+  }
+  const Real log_law = us * us;
+  return log_law > laminar ? log_law : laminar;
+}
+
 // Twice the viscosity of a pair, 2 mu_ij: the harmonic mean mu_ij = 2 mu_i mu_j / (mu_i + mu_j)
 // (Hu & Adams 2006, physics.md C10), which lets the less viscous side set the shear stress across
 // an interface, as for layers in series. Equal viscosities give mu_i + mu_j, bit for bit.

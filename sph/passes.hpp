@@ -599,6 +599,36 @@ TURBID_HD inline bool central_stress_pair(const MaterialParams& Mi, const Materi
   return Mi.central_stress || (fluid_j && Mj.central_stress);
 }
 
+// Wall shear of boundary particle j on fluid particle i (PhysicsParams::wall_function):
+//   a_i = -2 u*^2 t V_j max(0, -F r_ij . n_j),
+// t the direction of i's velocity relative to j along j's wall surface (normal n_j, from
+// boundary_normal, the surface half of it beyond x_j), u*^2 from the log law at i's distance
+// y = r_ij . n_j - |boundary_normal_j| / 2 from that surface. The weight is the wall's share of
+// -d gamma / dy, gamma_i = sum_b V_b W_ib the wall's part of i's kernel: across a plane wall it
+// integrates to gamma at the surface, 1/2, so the fluid particles over a unit of wall area take
+// rho u*^2 in all, whatever the spacing. The structure-force pass takes the reaction pair by pair.
+template <int D>
+TURBID_HD inline Vec<D> wall_friction_pair(const ParticleView<D>& P, const PhysicsParams& prm, const Vec<D>& vi,
+                                           Real rho_i, Real mu_i, std::uint32_t j, const Vec<D>& rij, Real F) {
+  const Vec<D> nb = P.boundary_normal[j];
+  const Real n2 = norm2(nb);
+  if (!(n2 > Real(0))) return Vec<D>::zero();
+  const Real inv_n = Real(1) / std::sqrt(n2);
+  const Vec<D> n = inv_n * nb;
+  const Real rn = dot(rij, n);
+  const Real weight = -F * rn;  // F < 0
+  if (!(weight > Real(0))) return Vec<D>::zero();
+  const Vec<D> vr = vi - P.velocity[j];
+  const Vec<D> vt = vr - dot(vr, n) * n;
+  const Real u_t = std::sqrt(norm2(vt));
+  if (!(u_t > Real(0))) return Vec<D>::zero();
+  Real y = rn - Real(0.5) * n2 * inv_n;
+  y = y > prm.wall_function_min_distance ? y : prm.wall_function_min_distance;
+  const Real us2 = pair::wall_friction_velocity2(u_t, y, mu_i / rho_i, prm.wall_roughness_length);
+  const Real vol_j = P.mass[j] / P.density[j];
+  return (Real(-2) * us2 * vol_j * weight / u_t) * vt;
+}
+
 // Acceleration of fluid particle i (velocity vi, density rho_i, pressure p_i, smoothing length
 // h_i, material Mi, viscosity mu_i) due to particle j at r_ij = x_i - x_j: pressure and viscosity
 // (physics.md C10, C2). Boundary particles take the fluid's viscosity mu_i (no-slip in the fluid's
@@ -618,13 +648,18 @@ TURBID_HD inline Vec<D> momentum_pair(const ParticleView<D>& P, const PhysicsPar
   const Vec<D> vij = vi - viscous_velocity_of<D>(P, j);
   const Real eta2 = kEta2Factor * h * h;
   Real s = pair::pressure(m_j, p_i, P.pressure[j], rho_i, rho_j, F);
+  const bool fluid_j = P.kind[j] == std::uint8_t(Kind::fluid);
+  const bool free_slip_j = !fluid_j && P.free_slip && P.free_slip[j];
+  // The wall function carries the whole wall shear, viscous sublayer included.
+  const bool wall_function = prm.wall_function && !fluid_j && !free_slip_j;
   if (prm.viscosity == Viscosity::artificial) {
     s += pair::artificial_viscosity(prm.artificial_viscosity, h, Real(0.5) * (Mi.sound_speed + Mj.sound_speed),
                                     Real(0.5) * (rho_i + rho_j), m_j, dot(vij, rij), r2, eta2, F);
+    if (wall_function) return s * rij + wall_friction_pair<D>(P, prm, vi, rho_i, mu_i, j, rij, F);
     return s * rij;
   }
-  const bool fluid_j = P.kind[j] == std::uint8_t(Kind::fluid);
-  if (!fluid_j && P.free_slip && P.free_slip[j]) return s * rij;  // a free-slip wall exerts no shear
+  if (free_slip_j) return s * rij;  // a free-slip wall exerts no shear
+  if (wall_function) return s * rij + wall_friction_pair<D>(P, prm, vi, rho_i, mu_i, j, rij, F);
   // Pairs of an implicitly integrated material with itself or a boundary: the implicit viscous
   // update has them (sph/implicit_viscosity.hpp).
   if (implicit_pair(Mi, Mj, fluid_j)) return s * rij;
@@ -659,7 +694,7 @@ struct MomentumPass {
     const bool artificial = prm.viscosity == Viscosity::artificial;
 #if !defined(__CUDA_ARCH__)
     if constexpr (UniformH) {
-      if (artificial && P.viscous_velocity == nullptr && P.shifting_velocity == nullptr &&
+      if (artificial && P.viscous_velocity == nullptr && P.shifting_velocity == nullptr && !prm.wall_function &&
           lanes(i, xi, vi, rho_i, p_i, Mi, acc)) {
         for (int k = 0; k < D; ++k) acc[k] += prm.gravity[k];
         P.acceleration[i] = acc;

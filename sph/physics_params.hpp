@@ -83,6 +83,13 @@ struct PhysicsParams {
   // particles). Without it a particle beside a box's corner, 4 dx off, saw only the top row's
   // plane and was put on it.
   Real wall_constraint_reach = Real(0);
+  // Wall function: fluid sliding along a wall or structure (not a free-slip wall) feels the wall
+  // shear stress rho u*^2 of the log law (pair::wall_friction_velocity2), spread over the fluid
+  // particles by the wall's kernel gradient; with laminar viscosity it replaces the viscous pair
+  // terms with boundary particles (needs boundary_normal). Off: walls act through the viscosity alone.
+  bool wall_function = false;
+  Real wall_roughness_length = Real(0);  // z_r = k_s / 30 [m]; 0: hydraulically smooth
+  Real wall_function_min_distance = Real(0);  // y is held at this or more [m] (dx / 10)
   Real mdbc_wet_share = Real(0.5);  // mDBC: a ghost node with less fluid than this share of its support is dry
   // Some walls are free-slip: their particles carry the `free_slip` field, and the viscous terms
   // (laminar viscosity, velocity gradient) leave them out.

@@ -492,7 +492,9 @@ std::string describe_scene(const fsi::Scene& scene) {
   if (s.buffer_particles > 0) os << ", open-boundary buffer " << s.buffer_particles;
   os << ")\n";
   os << "wall treatment   " << (scene.numerics.boundary == fsi::BoundaryKind::mdbc ? "mDBC" : "DBC")
-     << (sim.params().wall_no_slip ? " (no-slip: mirrored velocity)" : " (wall velocity)") << "\n";
+     << (sim.params().wall_no_slip ? " (no-slip: mirrored velocity)" : " (wall velocity)");
+  if (scene.numerics.wall_function) os << ", log-law wall function (k_s = " << scene.numerics.wall_roughness << " m)";
+  os << "\n";
   const bool two_d = scene.dimensions == 2;
   for (const auto& st : s.structures)
     os << "  structure " << st.name << ": " << st.particles << " particles, surface "
@@ -826,6 +828,8 @@ nlohmann::json run_scene(const RunRequest& request) {
   // The velocity the viscous terms see at walls: the fluid's mirrored at ghost nodes or the wall's own.
   report["wall_treatment"] = {{"type", scene.numerics.boundary == fsi::BoundaryKind::mdbc ? "mdbc" : "dbc"},
                               {"velocity", sim.params().wall_no_slip ? "no_slip" : "wall"}};
+  if (scene.numerics.wall_function)
+    report["wall_treatment"]["wall_function"] = {{"law", "log"}, {"roughness_m", scene.numerics.wall_roughness}};
   report["threads"] = sim.threads();
   report["git_revision"] = TURBID_GIT_REVISION;
   report["version"] = TURBID_VERSION;

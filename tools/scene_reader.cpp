@@ -684,10 +684,17 @@ void Reader::read_numerics(const Value& v, fsi::NumericsSpec& n) const {
                          std::to_string(n.split_relaxation));
   }
   if (auto bv = m.get("boundary")) {
-    MapView b(*this, *bv, {"type", "velocity", "impermeable"});
+    MapView b(*this, *bv, {"type", "velocity", "impermeable", "wall_function"});
     n.boundary = choice(b.need("type"), {"dbc", "mdbc"}) == 0 ? fsi::BoundaryKind::dbc : fsi::BoundaryKind::mdbc;
     if (auto vel = b.get("velocity")) n.no_slip = choice(*vel, {"no_slip", "wall"}) == 0;
     if (auto imp = b.get("impermeable")) n.impermeable = boolean(*imp);
+    // `wall_function: {roughness: k_s}`: the log law's wall shear (docs/choices.md, "Wall friction").
+    if (auto wf = b.get("wall_function")) {
+      MapView w(*this, *wf, {"roughness"});
+      n.wall_function = true;
+      n.wall_function_where = where(wf->mark);
+      if (auto ks = w.get("roughness")) n.wall_roughness = number(*ks, non_negative(), "m");
+    }
   }
   if (auto k = m.get("kernel"))
     n.kernel = choice(*k, {"wendland_c2", "cubic_spline"}) == 0 ? sph::KernelKind::wendland_c2

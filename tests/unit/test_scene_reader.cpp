@@ -295,6 +295,36 @@ TEST(SceneReader, ShiftingIsReadWithItsCoefficientAndThreshold) {
   EXPECT_NE(negative.find("'coefficient' must be a positive number"), std::string::npos) << negative;
 }
 
+// The wall function: off unless the scene asks; smooth (k_s = 0) unless a roughness is given; a
+// negative roughness is refused at its place; a non-Newtonian (implicitly integrated) material is
+// refused with the key's place, since the implicit update holds the wall's viscous terms.
+TEST(SceneReader, WallFunctionIsReadWithItsRoughness) {
+  const std::string head =
+      "name: t\ndimensions: 2\nresolution: {particle_spacing: 0.01}\n"
+      "time: {end: 0.1}\nmaterials: {water: {density: 1000}}\nfluids: [{material: water, box: {min: [0, 0], max: [0.1, 0.1]}}]\n";
+  EXPECT_FALSE(read_scene_string(head, "a.yaml").numerics.wall_function);
+  const auto smooth = read_scene_string(head + "numerics: {boundary: {type: mdbc, wall_function: {}}}\n", "b.yaml");
+  EXPECT_TRUE(smooth.numerics.wall_function);
+  EXPECT_EQ(smooth.numerics.wall_roughness, 0.0);
+  const auto rough =
+      read_scene_string(head + "numerics: {boundary: {type: dbc, wall_function: {roughness: 0.002}}}\n", "c.yaml");
+  EXPECT_DOUBLE_EQ(rough.numerics.wall_roughness, 0.002);
+  const std::string negative =
+      error_of_string(head + "numerics: {boundary: {type: dbc, wall_function: {roughness: -1}}}\n", "d.yaml");
+  EXPECT_EQ(negative.rfind("d.yaml:7:61: error: 'roughness' must be a number >= 0 [m]", 0), 0u) << negative;
+  const std::string mud =
+      "name: t\ndimensions: 2\nresolution: {particle_spacing: 0.01}\ntime: {end: 0.1}\n"
+      "materials: {mud: {model: bingham, density: 1500, viscosity: 1, yield_stress: 10, papanastasiou_exponent: 100}}\n"
+      "fluids: [{material: mud, box: {min: [0, 0], max: [0.1, 0.1]}}]\n"
+      "numerics:\n  viscosity: {type: laminar}\n  boundary: {type: mdbc, wall_function: {roughness: 0}}\n";
+  try {
+    turbid::fsi::physics_params(read_scene_string(mud, "e.yaml"));
+    ADD_FAILURE() << "no error for a wall function with implicit viscosity";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("e.yaml:9:41: error: 'wall_function' does not combine", 0), 0u) << e.what();
+  }
+}
+
 // The 2D good scene: every section given with non-default values, checked against the file.
 TEST(SceneReader, GoodDamBreak2dParsesToTheWrittenValues) {
   const std::string path = kData + "/good_scenes/dam_break_2d.yaml";
