@@ -178,19 +178,47 @@ double evaluate(const Scene& scene, const ProbeSpec& probe, const sph::ParticleS
         return den > 0 && den >= probe.min_kernel_sum ? num / den : std::nan("");
       };
       if (probe.sensor_diameter <= 0) return at_point(probe.point);
-      // A wall sensor: the mean over its face, each sample standing for an equal share of the area;
-      // samples without fluid read ambient 0, and a face wholly dry reads nan.
+      // A wall sensor: the mean over its face, each sample standing for an equal share of the area,
+      // and each sample the mean over its kernel of what is there: water at its pressure, air at
+      // ambient 0. The walls' share of the kernel, sum_b W V_b over boundary particles, is neither,
+      // so a sample reads sum_j p_j W V_j / max(sum_j W V_j, 1 - walls): in water (the fluid fills
+      // what the walls leave) the Shepard value, where a spray sheet one particle thick fills a
+      // tenth of the kernel a tenth of its pressure. (The Shepard value alone spreads the sheet's
+      // pressure over the whole kernel, 2h wide at every spacing: the reading of a face larger
+      // than the sheet then did not fall as the spacing, and the sheet, shrank.) A face with no
+      // fluid within reach reads nan.
+      std::vector<std::size_t> walls;
+      for (std::size_t i = 0; i < n; ++i)
+        if (!fluid(i) && double(sph::norm2(x[i] - centre)) < reach * reach) walls.push_back(i);
       const auto samples = sensor_face_points<D>(probe.point, probe.sensor_normal, probe.sensor_diameter,
                                                  scene.particle_spacing);
-      double sum = 0;
-      bool wet = false;
-      for (const auto& q : samples) {
-        const double v_q = at_point(q);
-        if (std::isnan(v_q)) continue;
-        sum += v_q;
-        wet = true;
-      }
-      return wet ? sum / double(samples.size()) : std::nan("");
+      double sum = 0, fluid_sum = 0;
+      sph::dispatch_kernel<D>(params, [&](auto kernel_tag, auto) {
+        using K = typename decltype(kernel_tag)::type;
+        auto kernel_sum = [&](const std::vector<std::size_t>& list, const V& at, double* weighted) {
+          double total = 0, with_p = 0;
+          for (std::size_t i : list) {
+            const double r = std::sqrt(double(sph::norm2(x[i] - at)));
+            if (r >= 2 * h) continue;
+            const double w = K::w(Real(r), Real(h)) * double(m[i]) / double(rho[i]);
+            total += w;
+            if (weighted) with_p += w * p[i];
+          }
+          if (weighted) *weighted = with_p;
+          return total;
+        };
+        for (const auto& q : samples) {
+          V at;
+          for (int k = 0; k < D; ++k) at[k] = Real(q[std::size_t(k)]);
+          double num = 0;
+          const double den = kernel_sum(near, at, &num);
+          if (!(den > 0)) continue;
+          const double open = 1.0 - kernel_sum(walls, at, nullptr);
+          sum += num / std::max(den, open);
+          fluid_sum += den;
+        }
+      });
+      return fluid_sum > 0 ? sum / double(samples.size()) : std::nan("");
     }
     case ProbeSpec::Type::max_speed: {
       double v2 = 0;

@@ -244,8 +244,8 @@ struct ProbeSpec {
   // particle at the point gives 0.14 (2D) or 0.05 (3D) with h = 2 dx.
   double min_kernel_sum = 0.2;
   // pressure as a wall sensor reads it: the average over a face of this diameter [m] centred on
-  // `point` and normal to `sensor_normal` (a segment in 2D, a disc in 3D); the parts of the face
-  // without fluid read 0 (ambient). 0: the pressure at the point.
+  // `point` and normal to `sensor_normal` (a segment in 2D, a disc in 3D), air counted at ambient 0
+  // (fsi/probes.cpp); min_kernel_sum does not apply. 0: the pressure at the point.
   double sensor_diameter = 0;
   Vec3d sensor_normal{1, 0, 0};
   SourceLocation where;

@@ -152,6 +152,55 @@ TEST(PressureProbe, SensorFaceAveragesOverItsDiameter) {
   EXPECT_TRUE(std::isnan(v[1])) << v[1];
 }
 
+// Issue #25 item 1: a wall sensor counts air at ambient 0, so a spray sheet one particle thick
+// reads in proportion to the water on the face, not as if it covered it. Reference: conservation
+// of the water's volume in the kernel sum: a row of particles at spacing dx has dx of water per
+// unit length across it, so the face's mean of sum_j p_j W V_j over a face of diameter d across
+// the row is P dx / d (here 1/10 of P); measured 4997.7 Pa for 5000 (the face's 33 samples and
+// the kernel's lattice sum), 1% allowed. The same sensor 1 dx off a wall in a block at P reads P:
+// the fluid fills what the wall leaves of each kernel (measured 49973 Pa for 50000, 0.5% allowed).
+TEST(PressureProbe, SensorReadsASprayByTheWaterOnItsFace) {
+  fsi::Scene s;
+  s.name = "sheet";
+  s.dimensions = 2;
+  s.particle_spacing = 0.01;
+  s.gravity = {0, 0, 0};
+  s.materials = {material("water", 1000)};
+  fsi::FluidBlock sheet;
+  sheet.material = "water";
+  sheet.box = {{0.2, 0.3, 0}, {0.6, 0.31, 0}};  // one row at y = 0.305
+  fsi::FluidBlock block;
+  block.material = "water";
+  block.box = {{1.0, 0.0, 0}, {1.4, 0.3, 0}};
+  s.fluids = {sheet, block};
+  fsi::WallSpec tank;  // a tank around the block only: its floor and end walls
+  tank.box = {{1.0, 0.0, 0}, {1.4, 0.3, 0}};
+  tank.open = {false, false, false, true, false, false};
+  s.walls = {tank};
+  auto sensor = [](const char* name, double x, double y) {
+    fsi::ProbeSpec p;
+    p.name = name;
+    p.type = fsi::ProbeSpec::Type::pressure;
+    p.point = {x, y, 0};
+    p.sensor_diameter = 0.1;
+    p.sensor_normal = {-1, 0, 0};
+    return p;
+  };
+  s.probes = {sensor("sheet", 0.4, 0.305), sensor("wall", 1.39, 0.15)};
+  fsi::Simulation sim(s, {"cpu", 1});
+  sim.start();
+  auto& st = sim.store();
+  auto* p = st.data<float>(sim.fields().pressure);
+  const auto* kind = st.data<std::uint8_t>(sim.fields().kind);
+  const double P = 50000;  // [Pa] in every fluid particle
+  for (std::size_t i = 0; i < st.size(); ++i)
+    if (kind[i] == 0) p[i] = float(P);
+  const std::vector<double> v = sim.probe_values();
+  ASSERT_EQ(v.size(), 2u);
+  EXPECT_NEAR(v[0], P * 0.01 / 0.1, 0.01 * P * 0.01 / 0.1) << "a one-particle sheet across a 0.1 m face";
+  EXPECT_NEAR(v[1], P, 0.005 * P) << "a face 1 dx off the wall in water at P";
+}
+
 }  // namespace
 
 // Issue #27 item 11: the pressure probe is a Shepard average, so one stray particle used to give a
