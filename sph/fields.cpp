@@ -27,7 +27,7 @@ FieldIds register_fields(ParticleStore& s, const PhysicsParams& p, bool structur
   // Ghost node offset x_g - x_b: twice the particle's depth below the wall surface, along the
   // outward normal (zero for fluid).
   // Also for no-slip DBC walls (wall_no_slip), whose mirrored velocity comes from their ghost nodes.
-  if (p.boundary == Boundary::mdbc || p.wall_no_slip || p.wall_constraint || p.wall_function)
+  if (p.boundary == Boundary::mdbc || p.wall_no_slip || p.wall_constraint || p.wall_function || p.wall_viscosity_normal)
     f.boundary_normal = s.add_field({"boundary_normal", "m", ScalarType::f32, d, true, true, true, Carry::copy});
   // Recomputed by the mDBC pass after every sort, before the momentum pass reads it; the implicit
   // viscous update at the start of the next step reads it too, so with implicit viscosity it is
@@ -44,7 +44,7 @@ FieldIds register_fields(ParticleStore& s, const PhysicsParams& p, bool structur
   // checkpointed (they cannot be recomputed from rounded positions bit for bit).
   if (structures && moving_bodies) {
     f.body_offset = s.add_field({"body_offset", "m", ScalarType::f32, d, false, true, true, Carry::copy});
-    if (p.boundary == Boundary::mdbc || p.wall_no_slip || p.wall_constraint || p.wall_function)
+    if (p.boundary == Boundary::mdbc || p.wall_no_slip || p.wall_constraint || p.wall_function || p.wall_viscosity_normal)
       f.body_normal = s.add_field({"body_normal", "m", ScalarType::f32, d, false, true, true, Carry::copy});
   }
   // Computed by the momentum pass after each sort and used by the next drift, like the

@@ -653,8 +653,14 @@ TURBID_HD inline Vec<D> momentum_pair(const ParticleView<D>& P, const PhysicsPar
   // The wall function carries the whole wall shear, viscous sublayer included.
   const bool wall_function = prm.wall_function && !fluid_j && !free_slip_j;
   if (prm.viscosity == Viscosity::artificial) {
+    Real approach = dot(vij, rij);
+    if (prm.wall_viscosity_normal && !fluid_j) {
+      const Vec<D> nb = P.boundary_normal[j];
+      const Real n2 = norm2(nb);
+      if (n2 > Real(0)) approach = dot(vij, nb) * dot(rij, nb) / n2;
+    }
     s += pair::artificial_viscosity(prm.artificial_viscosity, h, Real(0.5) * (Mi.sound_speed + Mj.sound_speed),
-                                    Real(0.5) * (rho_i + rho_j), m_j, dot(vij, rij), r2, eta2, F);
+                                    Real(0.5) * (rho_i + rho_j), m_j, approach, r2, eta2, F);
     if (wall_function) return s * rij + wall_friction_pair<D>(P, prm, vi, rho_i, mu_i, j, rij, F);
     return s * rij;
   }
@@ -694,7 +700,7 @@ struct MomentumPass {
     const bool artificial = prm.viscosity == Viscosity::artificial;
 #if !defined(__CUDA_ARCH__)
     if constexpr (UniformH) {
-      if (artificial && P.viscous_velocity == nullptr && P.shifting_velocity == nullptr && !prm.wall_function &&
+      if (artificial && P.viscous_velocity == nullptr && P.shifting_velocity == nullptr && !prm.wall_function && !prm.wall_viscosity_normal &&
           lanes(i, xi, vi, rho_i, p_i, Mi, acc)) {
         for (int k = 0; k < D; ++k) acc[k] += prm.gravity[k];
         P.acceleration[i] = acc;

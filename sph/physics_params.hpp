@@ -88,6 +88,11 @@ struct PhysicsParams {
   // particles by the wall's kernel gradient; with laminar viscosity it replaces the viscous pair
   // terms with boundary particles (needs boundary_normal). Off: walls act through the viscosity alone.
   bool wall_function = false;
+  // Artificial viscosity between fluid and boundary particles takes the approach along the
+  // boundary particle's normal, (v_ij . n)(r_ij . n), instead of v_ij . r_ij: fluid sliding along a
+  // wall of particles approaches each wall particle ahead of it and leaves each behind, and the
+  // viscosity, which acts only on approach, pushed it off the wall and back (needs boundary_normal).
+  bool wall_viscosity_normal = false;
   Real wall_roughness_length = Real(0);  // z_r = k_s / 30 [m]; 0: hydraulically smooth
   Real wall_function_min_distance = Real(0);  // y is held at this or more [m] (dx / 10)
   Real mdbc_wet_share = Real(0.5);  // mDBC: a ghost node with less fluid than this share of its support is dry

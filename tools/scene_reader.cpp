@@ -710,7 +710,7 @@ void Reader::read_numerics(const Value& v, fsi::NumericsSpec& n) const {
     }
   }
   if (auto vv = m.get("viscosity")) {
-    MapView visc(*this, *vv, {"type", "alpha", "integration", "stress"});
+    MapView visc(*this, *vv, {"type", "alpha", "integration", "stress", "walls"});
     if (auto t = visc.get("type"))
       n.viscosity = choice(*t, {"artificial", "laminar"}) == 0 ? fsi::ViscosityKind::artificial
                                                                : fsi::ViscosityKind::laminar;
@@ -719,6 +719,13 @@ void Reader::read_numerics(const Value& v, fsi::NumericsSpec& n) const {
         fail(visc.key_mark("alpha"),
              "'alpha' applies only to 'artificial' viscosity; 'laminar' uses each material's 'viscosity'");
       n.artificial_viscosity = number(*alpha, non_negative());
+    }
+    // `walls: normal`: with walls and structures the artificial viscosity sees only the approach
+    // along the wall's normal (docs/choices.md, "Artificial viscosity at walls"); `pair`: the pair's.
+    if (auto wv = visc.get("walls")) {
+      if (n.viscosity == fsi::ViscosityKind::laminar)
+        fail(visc.key_mark("walls"), "'walls' applies only to 'artificial' viscosity");
+      n.artificial_wall_normal = choice(*wv, {"normal", "pair"}) == 0;
     }
     if (auto integ = visc.get("integration")) {
       if (n.viscosity != fsi::ViscosityKind::laminar)
