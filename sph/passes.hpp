@@ -700,7 +700,7 @@ struct MomentumPass {
     const bool artificial = prm.viscosity == Viscosity::artificial;
 #if !defined(__CUDA_ARCH__)
     if constexpr (UniformH) {
-      if (artificial && P.viscous_velocity == nullptr && P.shifting_velocity == nullptr && !prm.wall_function && !prm.wall_viscosity_normal &&
+      if (artificial && P.viscous_velocity == nullptr && P.shifting_velocity == nullptr && !prm.wall_function &&
           lanes(i, xi, vi, rho_i, p_i, Mi, acc)) {
         for (int k = 0; k < D; ++k) acc[k] += prm.gravity[k];
         P.acceleration[i] = acc;
@@ -781,6 +781,19 @@ struct MomentumPass {
       const std::uint32_t j = valid ? nb[k] : i;
       if (!valid) g.set_pad(k, h);
       g.set_vr(k, P, vi, j);
+      if (prm.wall_viscosity_normal && valid && P.kind[j] != std::uint8_t(Kind::fluid)) {
+        // The approach along the wall's normal (momentum_pair): vr is read by the viscosity only.
+        const Vec<D> nb = P.boundary_normal[j];
+        const Real n2 = norm2(nb);
+        if (n2 > Real(0)) {
+          Real vn = 0, rn = 0;
+          for (int a = 0; a < D; ++a) {
+            vn += (vi[a] - P.velocity[j][a]) * nb[a];
+            rn += g.r[a][k] * nb[a];
+          }
+          g.vr[k] = vn * rn / n2;
+        }
+      }
       rho_j[k] = P.density[j];
       p_j[k] = P.pressure[j];
       m_j[k] = valid ? P.mass[j] : Real(0);

@@ -13,8 +13,11 @@
 #include <cmath>
 #include <cstdint>
 
+#include <random>
+
 #include "fsi/scene.hpp"
 #include "fsi/simulation.hpp"
+#include "sph/vec.hpp"
 
 namespace {
 
@@ -89,6 +92,50 @@ TEST(WallViscosity, ThePairApproachPushesTheSameFlowOffTheWallAndBack) {
   // off the floor. Asserted in sign and above 1 m/s^2.
   EXPECT_GT(r.min_ay, 1.0) << "first-row acceleration away from the floor [m/s^2]";
   EXPECT_LT(r.max_ax, 0.0) << "first-row acceleration along the flow [m/s^2]";
+}
+
+// The vectorised pair lanes (fluid accelerations) and the structure-force pass (momentum_pair)
+// take the same normal approach: with random velocities around a cylinder and no walls or gravity,
+// sum_fluid m a + F_structure = 0 to float accumulation (Newton's third law pair by pair, as in
+// tests/unit/test_structures.cpp).
+TEST(WallViscosity, StructureForceIsTheReactionWithTheNormalApproach) {
+  fsi::Scene s = sliding_water(true, fsi::BoundaryKind::mdbc);
+  s.walls.clear();
+  s.fluids[0].box.min = {0, 0, 0};
+  s.fluids[0].box.max = {0.4, 0.4, 0};
+  fsi::StructureSpec cyl;
+  cyl.name = "cylinder";
+  cyl.shape = fsi::StructureSpec::Shape::cylinder;
+  cyl.radius = 0.06;
+  cyl.length = 0.2;
+  cyl.position = {0.2, 0.2, 0};
+  cyl.reference_point = cyl.position;
+  s.structures = {cyl};
+  fsi::Simulation sim(s, {"cpu", 1});
+  sim.start();
+  auto& st = sim.store();
+  const auto& id = sim.fields();
+  auto* v = st.data<sph::Vec<2>>(id.velocity);
+  const auto* kind = st.data<std::uint8_t>(id.kind);
+  std::mt19937 rng(77u);
+  auto u = [&] { return double(rng() >> 8) * (1.0 / 16777216.0) - 0.5; };
+  for (std::size_t i = 0; i < st.size(); ++i)
+    if (kind[i] == 0) v[i] = sph::Vec<2>{float(2 * u()), float(2 * u())};
+  sim.backend().sync_from_host();
+  sim.backend().compute_forces();
+  const auto* a = st.data<sph::Vec<2>>(id.acceleration);
+  const auto* m = st.data<float>(id.mass);
+  double p[2] = {0, 0}, abs_sum = 0;
+  for (std::size_t i = 0; i < st.size(); ++i) {
+    if (kind[i] != 0) continue;
+    for (int k = 0; k < 2; ++k) p[k] += double(m[i]) * a[i][k];
+    abs_sum += double(m[i]) * std::hypot(double(a[i][0]), double(a[i][1]));
+  }
+  const auto loads = sim.structure_loads();
+  ASSERT_EQ(loads.size(), 1u);
+  ASSERT_GT(std::hypot(loads[0].force[0], loads[0].force[1]), 1e-4 * abs_sum) << "the cylinder feels a force";
+  for (int k = 0; k < 2; ++k) p[k] += loads[0].force[k];
+  EXPECT_LT(std::hypot(p[0], p[1]), 1e-6 * abs_sum);
 }
 
 }  // namespace
