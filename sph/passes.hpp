@@ -599,6 +599,15 @@ TURBID_HD inline bool central_stress_pair(const MaterialParams& Mi, const Materi
   return Mi.central_stress || (fluid_j && Mj.central_stress);
 }
 
+// The approach of fluid particle i to boundary particle j along j's normal n_j (its ghost offset),
+// (v_ij . n_j)(r_ij . n_j) / |n_j|^2, which the artificial viscosity takes for wall pairs with
+// PhysicsParams::wall_viscosity_normal; v_ij . r_ij where j has no normal.
+template <int D>
+TURBID_HD inline Real wall_normal_approach(const Vec<D>& vij, const Vec<D>& rij, const Vec<D>& nj) {
+  const Real n2 = norm2(nj);
+  return n2 > Real(0) ? dot(vij, nj) * dot(rij, nj) / n2 : dot(vij, rij);
+}
+
 // Wall shear of boundary particle j on fluid particle i (PhysicsParams::wall_function):
 //   a_i = -2 u*^2 t V_j max(0, -F r_ij . n_j),
 // t the direction of i's velocity relative to j along j's wall surface (normal n_j, from
@@ -653,12 +662,8 @@ TURBID_HD inline Vec<D> momentum_pair(const ParticleView<D>& P, const PhysicsPar
   // The wall function carries the whole wall shear, viscous sublayer included.
   const bool wall_function = prm.wall_function && !fluid_j && !free_slip_j;
   if (prm.viscosity == Viscosity::artificial) {
-    Real approach = dot(vij, rij);
-    if (prm.wall_viscosity_normal && !fluid_j) {
-      const Vec<D> nb = P.boundary_normal[j];
-      const Real n2 = norm2(nb);
-      if (n2 > Real(0)) approach = dot(vij, nb) * dot(rij, nb) / n2;
-    }
+    const Real approach =
+        prm.wall_viscosity_normal && !fluid_j ? wall_normal_approach<D>(vij, rij, P.boundary_normal[j]) : dot(vij, rij);
     s += pair::artificial_viscosity(prm.artificial_viscosity, h, Real(0.5) * (Mi.sound_speed + Mj.sound_speed),
                                     Real(0.5) * (rho_i + rho_j), m_j, approach, r2, eta2, F);
     if (wall_function) return s * rij + wall_friction_pair<D>(P, prm, vi, rho_i, mu_i, j, rij, F);
@@ -783,16 +788,9 @@ struct MomentumPass {
       g.set_vr(k, P, vi, j);
       if (prm.wall_viscosity_normal && valid && P.kind[j] != std::uint8_t(Kind::fluid)) {
         // The approach along the wall's normal (momentum_pair): vr is read by the viscosity only.
-        const Vec<D> nb = P.boundary_normal[j];
-        const Real n2 = norm2(nb);
-        if (n2 > Real(0)) {
-          Real vn = 0, rn = 0;
-          for (int a = 0; a < D; ++a) {
-            vn += (vi[a] - P.velocity[j][a]) * nb[a];
-            rn += g.r[a][k] * nb[a];
-          }
-          g.vr[k] = vn * rn / n2;
-        }
+        Vec<D> rij;
+        for (int a = 0; a < D; ++a) rij[a] = g.r[a][k];
+        g.vr[k] = wall_normal_approach<D>(vi - P.velocity[j], rij, P.boundary_normal[j]);
       }
       rho_j[k] = P.density[j];
       p_j[k] = P.pressure[j];
