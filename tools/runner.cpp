@@ -493,6 +493,7 @@ std::string describe_scene(const fsi::Scene& scene) {
   os << ")\n";
   os << "wall treatment   " << (scene.numerics.boundary == fsi::BoundaryKind::mdbc ? "mDBC" : "DBC")
      << (sim.params().wall_no_slip ? " (no-slip: mirrored velocity)" : " (wall velocity)");
+  if (sim.params().wall_viscosity_normal) os << ", artificial viscosity on the approach along the wall's normal";
   if (scene.numerics.wall_function) os << ", log-law wall function (k_s = " << scene.numerics.wall_roughness << " m)";
   os << "\n";
   const bool two_d = scene.dimensions == 2;
@@ -828,6 +829,8 @@ nlohmann::json run_scene(const RunRequest& request) {
   // The velocity the viscous terms see at walls: the fluid's mirrored at ghost nodes or the wall's own.
   report["wall_treatment"] = {{"type", scene.numerics.boundary == fsi::BoundaryKind::mdbc ? "mdbc" : "dbc"},
                               {"velocity", sim.params().wall_no_slip ? "no_slip" : "wall"}};
+  if (sim.params().viscosity == sph::Viscosity::artificial)
+    report["wall_treatment"]["artificial_viscosity_approach"] = sim.params().wall_viscosity_normal ? "normal" : "pair";
   if (scene.numerics.wall_function)
     report["wall_treatment"]["wall_function"] = {{"law", "log"}, {"roughness_m", scene.numerics.wall_roughness}};
   report["threads"] = sim.threads();

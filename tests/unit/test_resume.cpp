@@ -314,3 +314,22 @@ TEST(CheckpointResume, ResumedRunWithImplicitViscosityAndNoSlipDbcIsBitIdentical
   EXPECT_EQ(r.full.at("wall_treatment").at("velocity"), "no_slip") << "the full stress's default";
   EXPECT_GT(r.full.at("viscous_solves").get<long>(), 0) << "the implicit solve must run";
 }
+
+// Issue #25: the wall options are state-free (recomputed from positions and velocities each step),
+// so a run with the wall-normal artificial viscosity and the log-law wall function resumes bit for
+// bit; run.json says which approach and which wall function the run used.
+TEST(CheckpointResume, ResumedRunWithWallNormalViscosityAndWallFunctionIsBitIdentical) {
+  std::string scene = kScene;
+  const std::string walls = "walls:\n";
+  const auto at = scene.find(walls);
+  ASSERT_NE(at, std::string::npos);
+  scene.insert(at,
+               "numerics:\n  viscosity: {type: artificial, alpha: 0.02, walls: normal}\n"
+               "  boundary: {type: mdbc, wall_function: {roughness: 0.001}}\n");
+  const auto r = check_resume(scene);
+  EXPECT_EQ(r.full.at("status"), "completed");
+  EXPECT_EQ(r.full.at("wall_treatment").at("type"), "mdbc");
+  EXPECT_EQ(r.full.at("wall_treatment").at("artificial_viscosity_approach"), "normal");
+  EXPECT_EQ(r.full.at("wall_treatment").at("wall_function").at("roughness_m").get<double>(), 0.001);
+}
+
