@@ -821,6 +821,8 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
     backend = sph::make_cpu_backend(options.threads);
   } else if (options.backend == "cuda") {
     backend = sph::make_cuda_backend();
+  } else if (options.backend == "device-omp") {
+    backend = sph::make_omp_device_backend(options.threads);
   } else if (options.backend == "auto") {
     std::string why;
     backend = sph::cuda_device_count(&why) > 0 ? sph::make_cuda_backend() : sph::make_cpu_backend(options.threads);
@@ -833,7 +835,7 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
     if ((free_bodies || prescribed) && !backend->supports_moving_bodies())
       backend = sph::make_cpu_backend(options.threads);
   } else {
-    throw std::invalid_argument("unknown backend '" + options.backend + "' (expected auto, cpu or cuda)");
+    throw std::invalid_argument("unknown backend '" + options.backend + "' (expected auto, cpu, cuda or device-omp)");
   }
   if (!scene_.transitions.empty() && !backend->supports_splitting())
     throw std::invalid_argument("the scene has transitions (particle splitting), which the " + backend->name() +

@@ -39,6 +39,12 @@ struct HealthIssue {
   double value = 0;
 };
 
+// The health check and the statistics the next time step needs, of one state.
+struct StepCheck {
+  std::optional<HealthIssue> issue;
+  StepStats stats;
+};
+
 class Backend {
  public:
   virtual ~Backend() = default;
@@ -60,11 +66,23 @@ class Backend {
   virtual StepStats stats() = 0;
   // First particle with a non-finite value or a density ratio |rho/rho0 - 1| above the limit.
   virtual std::optional<HealthIssue> check_health(double density_ratio_limit) = 0;
+  // Both at once: the device backend does them in one reduction (one value back per step).
+  virtual StepCheck check_step(double density_ratio_limit) {
+    StepCheck c;
+    c.issue = check_health(density_ratio_limit);
+    if (!c.issue) c.stats = stats();
+    return c;
+  }
   virtual void sync_to_host() = 0;    // make the store current (no-op on the CPU)
   virtual void sync_from_host() = 0;  // the store was edited on the host (resume)
   // After a resume's neighbour update: rebuild whatever the last force pass left for the next
   // continuity pass (the CPU's neighbour list), so the resumed run matches bit for bit.
   virtual void prepare_resume() {}
+  // Bytes copied between host and device memory since construction (0 where they are one).
+  virtual std::uint64_t host_device_bytes() const { return 0; }
+  // Blocks of device memory allocated for temporary storage (sorts, scans, reductions) since
+  // construction; the device backend caches them, so steady steps add none (0 on the CPU).
+  virtual std::size_t temporary_allocations() const { return 0; }
   virtual std::size_t pair_count() = 0;  // neighbour pairs within the support in the last force pass
   // Force and torque of the fluid on each structure, from the last force pass (the exact reaction
   // of the fluid's accelerations); reference[k] is the point structure k's torque is taken about.
@@ -99,5 +117,9 @@ bool cuda_backend_compiled();
 // Number of CUDA devices usable now (0 without a driver/GPU or in a CPU-only build), with a reason.
 int cuda_device_count(std::string* reason);
 std::unique_ptr<Backend> make_cuda_backend();  // throws std::runtime_error if unavailable
+// The device backend's code built for Thrust's OpenMP system ("device-omp", backend/omp_device/):
+// the GPU code path run on CPU threads, so that it is tested without a GPU. Slower than "cpu".
+bool omp_device_backend_compiled();
+std::unique_ptr<Backend> make_omp_device_backend(int threads);  // throws std::runtime_error if not compiled
 
 }  // namespace turbid::sph

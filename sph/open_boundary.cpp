@@ -18,44 +18,30 @@ OpenBoundaryCounts update_open_boundaries(ParticleStore& s, const FieldIds& ids,
   std::uint8_t* kind = s.data<std::uint8_t>(ids.kind);
   std::uint8_t* zone = s.data<std::uint8_t>(ids.zone);
   std::uint8_t* material = s.data<std::uint8_t>(ids.material);
-  // Beyond the plane along the flow: (x_axis - plane) * sign > 0.
-  auto past = [&](std::size_t i, const BufferZone& z, Real plane) {
-    return (x[i * std::size_t(d) + std::size_t(z.axis)] - plane) * z.sign > Real(0);
-  };
-  auto inside_cross_section = [&](std::size_t i, const BufferZone& z) {
-    for (int a = 0; a < d; ++a) {
-      if (a == z.axis) continue;
-      const Real c = x[i * std::size_t(d) + std::size_t(a)];
-      if (c < z.lo[a] || c > z.hi[a]) return false;
-    }
-    return true;
-  };
   std::vector<std::size_t> spawn;
   std::vector<std::uint8_t> keep(n, 1);
   bool any_removed = false;
   for (std::size_t i = 0; i < n; ++i) {
-    if (kind[i] == std::uint8_t(Kind::buffer)) {
-      const BufferZone& z = p.zones[zone[i]];
-      if (z.type == ZoneType::inlet && past(i, z, z.plane)) {
+    std::uint8_t outlet = kNoZone;
+    switch (zone_crossing(x + i * std::size_t(d), d, kind[i], zone[i], p, &outlet)) {
+      case ZoneCrossing::inflow:
         kind[i] = std::uint8_t(Kind::fluid);
-        material[i] = z.material;
+        material[i] = p.zones[zone[i]].material;
         spawn.push_back(i);
         ++counts.inflow;
-      } else if (z.type == ZoneType::outlet && past(i, z, z.plane + z.sign * z.thickness)) {
+        break;
+      case ZoneCrossing::outflow:
         keep[i] = 0;
         any_removed = true;
         ++counts.outflow;
-      }
-    } else if (kind[i] == std::uint8_t(Kind::fluid)) {
-      for (int k = 0; k < p.zone_count; ++k) {
-        const BufferZone& z = p.zones[k];
-        if (z.type == ZoneType::outlet && past(i, z, z.plane) && inside_cross_section(i, z)) {
-          kind[i] = std::uint8_t(Kind::buffer);
-          zone[i] = std::uint8_t(k);
-          ++counts.to_outlet;
-          break;
-        }
-      }
+        break;
+      case ZoneCrossing::to_outlet:
+        kind[i] = std::uint8_t(Kind::buffer);
+        zone[i] = outlet;
+        ++counts.to_outlet;
+        break;
+      case ZoneCrossing::none:
+        break;
     }
   }
   if (!spawn.empty()) {

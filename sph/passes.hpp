@@ -702,7 +702,7 @@ struct MomentumPass {
     const Real h_i = UniformH ? prm.smoothing_length : P.smoothing_length[i];
     const MaterialParams& Mi = prm.materials[P.material[i]];
     const Real mu_i = P.effective_viscosity ? P.effective_viscosity[i] : Mi.dynamic_viscosity;
-    const bool artificial = prm.viscosity == Viscosity::artificial;
+    [[maybe_unused]] const bool artificial = prm.viscosity == Viscosity::artificial;  // the CPU lanes only
 #if !defined(__CUDA_ARCH__)
     if constexpr (UniformH) {
       if (artificial && P.viscous_velocity == nullptr && P.shifting_velocity == nullptr && !prm.wall_function &&

@@ -43,6 +43,7 @@ void Solver::resume(double time, std::uint64_t steps, std::uint64_t removed) {
   time_ = time;
   steps_ = steps;
   removed_ = removed;
+  checked_stats_.reset();
   backend_->sync_from_host();
   // Rebuild the grid of the restored positions; they were sorted when saved, and the stable sort
   // keeps that order, so the run continues exactly as if it had not stopped.
@@ -51,7 +52,7 @@ void Solver::resume(double time, std::uint64_t steps, std::uint64_t removed) {
 }
 
 double Solver::next_time_step() {
-  const StepStats s = backend_->stats();
+  const StepStats s = checked_stats_ ? *checked_stats_ : backend_->stats();
   return stable_time_step(params_, time_params_, s.max_speed, s.max_acceleration);
 }
 
@@ -63,6 +64,7 @@ void Solver::step(double dt) {
        << ", t = " << time_ << " s";
     throw BlowUp(os.str());
   }
+  checked_stats_.reset();
   backend_->kick(0.5 * dt);
   if (coupling_) coupling_->after_kick(*backend_, 0.5 * dt);
   // The stiff viscous terms over half a step after each half-kick (K/2 V/2 D F K/2 V/2: a
@@ -147,7 +149,10 @@ void Solver::lower_daughter_h(double h) {
 }
 
 void Solver::check(const char* phase) {
-  if (auto issue = backend_->check_health(time_params_.density_ratio_limit)) {
+  StepCheck c = backend_->check_step(time_params_.density_ratio_limit);
+  checked_stats_ = c.stats;
+  if (auto& issue = c.issue) {
+    checked_stats_.reset();
     std::ostringstream os;
     os << "numerical blow-up after " << phase << " " << steps_ << " (t = " << time_ << " s): particle id " << issue->id
        << " has " << issue->field << " = " << issue->value;

@@ -126,6 +126,8 @@ class Solver {
   std::uint64_t removed_ = 0;
   std::uint64_t inflow_ = 0;
   std::uint64_t outflow_ = 0;
+  // The statistics of the state check() last saw healthy, for next_time_step(); cleared when a step begins.
+  std::optional<StepStats> checked_stats_;
 };
 
 }  // namespace turbid::sph

@@ -25,7 +25,8 @@ int cmd_info() {
   std::printf("turbid %s (git %s, %s build)\n", TURBID_VERSION, TURBID_GIT_REVISION, TURBID_BUILD_TYPE);
   std::printf("precision        particle fields float32, conservation sums float64\n");
   std::printf("backends         cpu (OpenMP, %d threads available)", omp_get_max_threads());
-  std::printf("%s\n", turbid::sph::cuda_backend_compiled() ? ", cuda (compiled in)" : "");
+  std::printf("%s", turbid::sph::cuda_backend_compiled() ? ", cuda (compiled in)" : "");
+  std::printf("%s\n", turbid::sph::omp_device_backend_compiled() ? ", device-omp (compiled in)" : "");
   std::printf("rigid bodies     built-in (motion: free)%s\n",
               turbid::fsi::bullet_available() ? ", Bullet double precision (motion: bullet)"
                                               : "; no Bullet (motion: bullet refused; install libbullet-dev and rebuild)");
@@ -56,7 +57,9 @@ int main(int argc, char** argv) {
   auto* run = app.add_subcommand("run", "Run a scene and write its results");
   run->add_option("scene", scene_file, "Scene file (YAML)");
   run->add_option("--out", out, "Run directory (default: runs/<scene name>)");
-  run->add_option("--backend", req.backend, "auto | cpu | cuda")->check(CLI::IsMember({"auto", "cpu", "cuda"}));
+  run->add_option("--backend", req.backend,
+                  "auto | cpu | cuda | device-omp (the CUDA backend's code on CPU threads, for testing it without a GPU)")
+      ->check(CLI::IsMember({"auto", "cpu", "cuda", "device-omp"}));
   run->add_option("--threads", req.threads, "CPU threads, 0 = all (default)")->check(CLI::Range(0, 4096));
   run->add_option("--end", end, "End time [s], overrides the scene");
   run->add_option("--spacing", spacing, "Particle spacing [m], overrides the scene");

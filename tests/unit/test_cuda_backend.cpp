@@ -28,6 +28,7 @@
 #include "sph/physics_params.hpp"
 #include "sph/split_params.hpp"
 #include "sph/vec.hpp"
+#include "tests/device_backends.hpp"
 
 namespace {
 
@@ -210,14 +211,14 @@ std::vector<float> by_id(const ParticleStore& ref, const ParticleStore& got, con
 }
 
 template <int D>
-void run_parity(const Case& c) {
+void run_parity(const Case& c, const std::string& device) {
   const PhysicsParams params = make_params(c);
   ParticleStore cpu_store, gpu_store;
   Domain domain;
   const FieldIds ids = build_block<D>(cpu_store, params, domain);
   build_block<D>(gpu_store, params, domain);
   auto cpu = make_cpu_backend(2);
-  auto gpu = make_cuda_backend();
+  auto gpu = turbid::testing::make_device_backend(device);
   cpu->bind(cpu_store, ids, params, domain);
   gpu->bind(gpu_store, ids, params, domain);
 
@@ -298,11 +299,11 @@ void run_parity(const Case& c) {
 class CudaParity : public ::testing::TestWithParam<Case> {};
 
 TEST_P(CudaParity, MatchesCpuBackend) {
-  std::string reason;
-  if (cuda_device_count(&reason) == 0) GTEST_SKIP() << reason;
   const Case& c = GetParam();
-  if (c.dimensions == 2) run_parity<2>(c);
-  else run_parity<3>(c);
+  turbid::testing::for_each_device_backend([&](const std::string& device) {
+    if (c.dimensions == 2) run_parity<2>(c, device);
+    else run_parity<3>(c, device);
+  });
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -417,7 +418,7 @@ struct SplitRun {
 // update (the same sorted order on both, see the parity test above), and checks the counts, the
 // sizes and every field byte for byte. Conservation is checked on the GPU's store.
 template <int D, class Material, class Stress>
-SplitRun split_on_both(int n, std::size_t capacity, Material material, Stress stress, const SplitParams& rules) {
+SplitRun split_on_both(const std::string& device, int n, std::size_t capacity, Material material, Stress stress, const SplitParams& rules) {
   SplitRun run;
   const PhysicsParams p = splitting_params(D);
   ParticleStore cpu_store, gpu_store;
@@ -425,7 +426,7 @@ SplitRun split_on_both(int n, std::size_t capacity, Material material, Stress st
   const FieldIds ids = build_lattice<D>(cpu_store, p, dom, n, capacity, material, stress);
   build_lattice<D>(gpu_store, p, dom, n, capacity, material, stress);
   auto cpu = make_cpu_backend(2);
-  auto gpu = make_cuda_backend();
+  auto gpu = turbid::testing::make_device_backend(device);
   EXPECT_TRUE(gpu->supports_splitting());
   cpu->bind(cpu_store, ids, p, dom);
   gpu->bind(gpu_store, ids, p, dom);
@@ -477,53 +478,53 @@ SplitRun split_on_both(int n, std::size_t capacity, Material material, Stress st
 // Debris in the lower half under water, stress 0..299 Pa in a fixed pattern, threshold 150 Pa,
 // only particles next to the water (`where: interface`) split.
 TEST(CudaSplitting, InterfaceSplitMatchesCpuBitwise2D) {
-  std::string reason;
-  if (cuda_device_count(&reason) == 0) GTEST_SKIP() << reason;
-  constexpr int n = 40;
-  const SplitRun r = split_on_both<2>(
-      n, std::size_t(n * n) * 4, [](const Vec<2>& x) { return x[1] < Real(0.2) ? 1 : 0; },
-      [](std::size_t i) { return double((i * 53) % 300); }, debris_to_turbidity(150.0, true));
-  EXPECT_GT(r.cpu.splits, 10u);
-  EXPECT_EQ(r.cpu.refused, 0u);
+  turbid::testing::for_each_device_backend([&](const std::string& device) {
+    constexpr int n = 40;
+    const SplitRun r = split_on_both<2>(
+        device, n, std::size_t(n * n) * 4, [](const Vec<2>& x) { return x[1] < Real(0.2) ? 1 : 0; },
+        [](std::size_t i) { return double((i * 53) % 300); }, debris_to_turbidity(150.0, true));
+    EXPECT_GT(r.cpu.splits, 10u);
+    EXPECT_EQ(r.cpu.refused, 0u);
+  });
 }
 
 // 3D, every debris particle above the threshold splits (8 daughters; the cube root of the edge).
 TEST(CudaSplitting, SplitMatchesCpuBitwise3D) {
-  std::string reason;
-  if (cuda_device_count(&reason) == 0) GTEST_SKIP() << reason;
-  constexpr int n = 12;
-  const SplitRun r = split_on_both<3>(
-      n, std::size_t(n * n * n) * 8, [](const Vec<3>& x) { return x[2] < Real(0.08) ? 1 : 0; },
-      [](std::size_t i) { return double((i * 37) % 200); }, debris_to_turbidity(100.0, false));
-  EXPECT_GT(r.cpu.splits, 300u);
-  EXPECT_EQ(r.cpu.daughters, 7 * r.cpu.splits);
-  EXPECT_EQ(r.cpu.refused, 0u);
+  turbid::testing::for_each_device_backend([&](const std::string& device) {
+    constexpr int n = 12;
+    const SplitRun r = split_on_both<3>(
+        device, n, std::size_t(n * n * n) * 8, [](const Vec<3>& x) { return x[2] < Real(0.08) ? 1 : 0; },
+        [](std::size_t i) { return double((i * 37) % 200); }, debris_to_turbidity(100.0, false));
+    EXPECT_GT(r.cpu.splits, 300u);
+    EXPECT_EQ(r.cpu.daughters, 7 * r.cpu.splits);
+    EXPECT_EQ(r.cpu.refused, 0u);
+  });
 }
 
 // 3D with `where: interface`: the neighbour search of the flag pass on the GPU's grid.
 TEST(CudaSplitting, InterfaceSplitMatchesCpuBitwise3D) {
-  std::string reason;
-  if (cuda_device_count(&reason) == 0) GTEST_SKIP() << reason;
-  constexpr int n = 12;
-  const SplitRun r = split_on_both<3>(
-      n, std::size_t(n * n * n) * 8, [](const Vec<3>& x) { return x[2] < Real(0.06) ? 1 : 0; },
-      [](std::size_t i) { return double((i * 37) % 200); }, debris_to_turbidity(50.0, true));
-  EXPECT_GT(r.cpu.splits, 50u);
-  EXPECT_EQ(r.cpu.refused, 0u);
+  turbid::testing::for_each_device_backend([&](const std::string& device) {
+    constexpr int n = 12;
+    const SplitRun r = split_on_both<3>(
+        device, n, std::size_t(n * n * n) * 8, [](const Vec<3>& x) { return x[2] < Real(0.06) ? 1 : 0; },
+        [](std::size_t i) { return double((i * 37) % 200); }, debris_to_turbidity(50.0, true));
+    EXPECT_GT(r.cpu.splits, 50u);
+    EXPECT_EQ(r.cpu.refused, 0u);
+  });
 }
 
 // Room for 10 splits (30 new slots in 2D) among 50 candidates: on both backends the 10 lowest-index
 // candidates split and 40 are refused, and nothing is written past the capacity.
 TEST(CudaSplitting, FullStoreRefusesTheSameMothers) {
-  std::string reason;
-  if (cuda_device_count(&reason) == 0) GTEST_SKIP() << reason;
-  constexpr int n = 10;
-  const SplitRun r = split_on_both<2>(
-      n, std::size_t(n * n) + 31, [](const Vec<2>&) { return 1; },
-      [](std::size_t i) { return i % 2 == 0 ? 200.0 : 0.0; }, debris_to_turbidity(150.0, false));
-  EXPECT_EQ(r.gpu.splits, 10u);
-  EXPECT_EQ(r.gpu.refused, std::size_t(n * n / 2 - 10));
-  EXPECT_EQ(r.gpu.daughters, 30u);
+  turbid::testing::for_each_device_backend([&](const std::string& device) {
+    constexpr int n = 10;
+    const SplitRun r = split_on_both<2>(
+        device, n, std::size_t(n * n) + 31, [](const Vec<2>&) { return 1; },
+        [](std::size_t i) { return i % 2 == 0 ? 200.0 : 0.0; }, debris_to_turbidity(150.0, false));
+    EXPECT_EQ(r.gpu.splits, 10u);
+    EXPECT_EQ(r.gpu.refused, std::size_t(n * n / 2 - 10));
+    EXPECT_EQ(r.gpu.daughters, 30u);
+  });
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // Moving structures on the CUDA backend (sph/backend/cuda: place_bodies runs the shared placement
 // pass, sph/body_motion.hpp, on the device; the bodies themselves are integrated on the host by the
-// same fsi code for both backends). Skipped without a GPU. References and tolerances:
+// same fsi code for both backends). Runs on each device backend here (tests/device_backends.hpp:
+// "cuda" with a GPU, "device-omp" where compiled); skipped with neither. References and tolerances:
 //  - a free box pushed by a block of water (test::push_scene, 2D, no gravity) takes the CPU's path
 //    over 100 steps within 1e-3 of its displacement: the fluid forces differ only by float32
 //    association and fused multiply-adds (1e-5 of the largest acceleration, CudaParity), which the
@@ -20,6 +21,7 @@
 #include "fsi/bullet_world.hpp"
 #include "fsi/simulation.hpp"
 #include "sph/backend.hpp"
+#include "tests/device_backends.hpp"
 #include "tools/scene_reader.hpp"
 
 namespace {
@@ -45,32 +47,32 @@ Eigen::Vector3d pushed(const std::string& motion, const std::string& backend, in
 }
 
 // The pushed box's path on the GPU against the CPU's, bound 1e-3 of its displacement.
-void expect_push_parity(const std::string& motion) {
+void expect_push_parity(const std::string& motion, const std::string& device) {
   double moved = 0;
   const Eigen::Vector3d cpu = pushed(motion, "cpu", 100, &moved);
-  const Eigen::Vector3d gpu = pushed(motion, "cuda", 100, nullptr);
-  std::printf("[ measured ] pushed %s box, 100 steps: moved %.4e m; cuda - cpu %.3e m\n", motion.c_str(), moved,
-              (gpu - cpu).norm());
+  const Eigen::Vector3d gpu = pushed(motion, device, 100, nullptr);
+  std::printf("[ measured ] pushed %s box, 100 steps: moved %.4e m; %s - cpu %.3e m\n", motion.c_str(), moved,
+              device.c_str(), (gpu - cpu).norm());
   ASSERT_GT(moved, 1e-3);
   EXPECT_LE((gpu - cpu).norm(), 1e-3 * moved);
 }
 
+void expect_prescribed_parity(const std::string& device);
+
 TEST(CudaBodies, PushedFreeBoxFollowsTheCpuPath) {
-  std::string reason;
-  if (sph::cuda_device_count(&reason) == 0) GTEST_SKIP() << reason;
-  expect_push_parity("free");
+  turbid::testing::for_each_device_backend([](const std::string& device) { expect_push_parity("free", device); });
 }
 
 TEST(CudaBodies, PushedBulletBoxFollowsTheCpuPath) {
-  std::string reason;
-  if (sph::cuda_device_count(&reason) == 0) GTEST_SKIP() << reason;
   if (!fsi::bullet_available()) GTEST_SKIP() << "built without Bullet";
-  expect_push_parity("bullet");
+  turbid::testing::for_each_device_backend([](const std::string& device) { expect_push_parity("bullet", device); });
 }
 
 TEST(CudaBodies, PrescribedCylinderParticlesSitWhereTheCpuPutsThem) {
-  std::string reason;
-  if (sph::cuda_device_count(&reason) == 0) GTEST_SKIP() << reason;
+  turbid::testing::for_each_device_backend([](const std::string& device) { expect_prescribed_parity(device); });
+}
+
+void expect_prescribed_parity(const std::string& device) {
   const std::string path = std::string(TURBID_SOURCE_DIR) + "/scenes/oscillating_cylinder_2d.yaml";
   auto run = [&](const std::string& backend) {
     fsi::Simulation sim(tools::read_scene_file(path), on(backend));
@@ -80,7 +82,7 @@ TEST(CudaBodies, PrescribedCylinderParticlesSitWhereTheCpuPutsThem) {
     sim.sync_to_host();
     return test::positions_by_id_2d(sim);
   };
-  const std::vector<double> cpu = run("cpu"), gpu = run("cuda");
+  const std::vector<double> cpu = run("cpu"), gpu = run(device);
   ASSERT_EQ(cpu.size(), gpu.size());
   fsi::Simulation probe(tools::read_scene_file(path), on("cpu"));
   const auto& s = probe.store();
@@ -93,7 +95,8 @@ TEST(CudaBodies, PrescribedCylinderParticlesSitWhereTheCpuPutsThem) {
     for (int a = 0; a < 2; ++a) worst = std::max(worst, std::abs(gpu[2 * id[i] + a] - cpu[2 * id[i] + a]));
     ++checked;
   }
-  std::printf("[ measured ] prescribed cylinder, 50 steps: %zu structure particles, cuda - cpu <= %.3e m\n", checked, worst);
+  std::printf("[ measured ] prescribed cylinder, 50 steps: %zu structure particles, %s - cpu <= %.3e m\n", checked,
+              device.c_str(), worst);
   ASSERT_GT(checked, 0u);
   EXPECT_LE(worst, 1e-6);
 }

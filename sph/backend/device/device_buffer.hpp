@@ -1,15 +1,13 @@
-// An owned, untyped block of device memory (move-only). The CUDA backend keeps one per particle
-// field, sized from the field registry, so it needs no code per field.
+// An owned, untyped block of device memory (move-only): GPU memory in the CUDA build, host memory
+// in the OpenMP build (device_system.hpp). The device backend keeps one per particle field, sized
+// from the field registry, so it needs no code per field.
 #pragma once
-#include <cuda_runtime.h>
-
 #include <cstddef>
-#include <string>
 #include <utility>
 
-#include "sph/backend/cuda/cuda_check.hpp"
+#include "sph/backend/device/device_system.hpp"
 
-namespace turbid::sph::cuda {
+namespace turbid::sph::TURBID_DEVICE_NS {
 
 class DeviceBuffer {
  public:
@@ -32,17 +30,14 @@ class DeviceBuffer {
   // Replaces the block by a fresh one of `bytes` (contents undefined).
   void allocate(std::size_t bytes) {
     release();
-    void* p = nullptr;
-    const cudaError_t e = cudaMalloc(&p, bytes > 0 ? bytes : 1);
-    if (e != cudaSuccess)
-      throw_cuda_error(e, "cudaMalloc(" + std::to_string(bytes) + " bytes)", __FILE__, __LINE__);
-    ptr_ = p;
+    ptr_ = device_allocate(bytes);
     bytes_ = bytes;
   }
   // Grows to at least `bytes`; contents are lost when it grows.
   void ensure(std::size_t bytes) {
     if (ptr_ == nullptr || bytes > bytes_) allocate(bytes);
   }
+  void clear() { clear_device(ptr_, bytes_); }
 
   void* get() const { return ptr_; }
   template <class T>
@@ -57,8 +52,7 @@ class DeviceBuffer {
 
  private:
   void release() noexcept {
-    // A destructor cannot throw; at program exit the runtime may already be unloaded.
-    if (ptr_ != nullptr) (void)cudaFree(ptr_);
+    device_free(ptr_);
     ptr_ = nullptr;
     bytes_ = 0;
   }
@@ -67,4 +61,4 @@ class DeviceBuffer {
   std::size_t bytes_ = 0;
 };
 
-}  // namespace turbid::sph::cuda
+}  // namespace turbid::sph::TURBID_DEVICE_NS
