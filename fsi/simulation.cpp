@@ -1426,6 +1426,7 @@ void Simulation::build_particles() {
   for (int m = 0; m < params_.material_count; ++m) summary_.sound_speed.push_back(params_.materials[m].sound_speed);
   // Store fields plus the neighbour search's keys, order and permutation scratch.
   summary_.bytes_per_particle = store_.bytes_per_particle() + 12;
+  summary_.device_memory = sph::device_memory_per_particle(store_, params_, !scene_.transitions.empty());
 }
 
 double Simulation::particle_steps_per_second() const {

@@ -14,6 +14,7 @@
 #include "fsi/scene.hpp"
 #include "fsi/wall_penetration.hpp"
 #include "sph/backend.hpp"
+#include "sph/backend/device/device_memory.hpp"
 #include "sph/fields.hpp"
 #include "sph/particle_store.hpp"
 #include "sph/solver.hpp"
@@ -54,6 +55,8 @@ struct WorldSummary {
   double smoothing_length = 0;     // [m]
   std::vector<double> sound_speed; // per material [m/s]
   std::size_t bytes_per_particle = 0;
+  // On a device backend (GPU, or device-omp): per particle of capacity (sph/backend/device/device_memory.hpp).
+  sph::DeviceMemory device_memory;
   sph::Domain domain;
   // "file:line:col: warning: ..." for layouts a user may mean but should know about (overlapping
   // fixed structures, fluid with nothing beneath it); `turbid check` and `run` print them.

@@ -83,6 +83,8 @@ class Backend {
   // Blocks of device memory allocated for temporary storage (sorts, scans, reductions) since
   // construction; the device backend caches them, so steady steps add none (0 on the CPU).
   virtual std::size_t temporary_allocations() const { return 0; }
+  // Bytes of device memory held now: buffers and cached temporary storage (0 on the CPU).
+  virtual std::size_t device_bytes() const { return 0; }
   virtual std::size_t pair_count() = 0;  // neighbour pairs within the support in the last force pass
   // Force and torque of the fluid on each structure, from the last force pass (the exact reaction
   // of the fluid's accelerations); reference[k] is the point structure k's torque is taken about.

@@ -389,21 +389,21 @@ struct SumRelaxMoment {
   }
 };
 
+// Particle i's share (the summand of a device transform-reduction).
 template <int D>
 struct RelaxMomentPass {
   const std::uint8_t* zone = nullptr;
   const Real* mass = nullptr;
   const Vec<D>* shift = nullptr;
-  RelaxMoment* out = nullptr;
 
-  TURBID_HD void operator()(std::uint32_t i) const {
+  TURBID_HD RelaxMoment operator()(std::uint32_t i) const {
     RelaxMoment r{0, 0, {0, 0, 0}};
     if (zone[i]) {
       r.count = 1;
       r.mass = double(mass[i]);
       for (int a = 0; a < D; ++a) r.moment[a] = double(mass[i]) * double(shift[i][a]);
     }
-    out[i] = r;
+    return r;
   }
 };
 

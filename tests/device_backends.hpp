@@ -1,6 +1,7 @@
 // The device backends a test of the GPU code path can run here: "cuda" where a usable GPU is, and
 // "device-omp" (the same device code built for Thrust's OpenMP system) where it is compiled, so
-// that CI runs these tests without a GPU. TURBID_DEVICE_BACKEND=cuda or =device-omp picks one.
+// that CI runs these tests without a GPU. TURBID_DEVICE_BACKEND=cuda or =device-omp picks one;
+// TURBID_REQUIRE_DEVICE_TESTS=1 (set by .ci/run) makes a missing backend a failure, not a skip.
 #pragma once
 #include <gtest/gtest.h>
 
@@ -43,7 +44,12 @@ template <class F>
 void for_each_device_backend(F&& body) {
   std::string why;
   const std::vector<std::string> names = device_backends(&why);
-  if (names.empty()) GTEST_SKIP() << why;
+  if (names.empty()) {
+    // CI sets this: there the device tests must run (on device-omp), not skip.
+    if (const char* req = std::getenv("TURBID_REQUIRE_DEVICE_TESTS"); req != nullptr && *req == '1')
+      FAIL() << "TURBID_REQUIRE_DEVICE_TESTS=1 but no device backend is available: " << why;
+    GTEST_SKIP() << why;
+  }
   for (const std::string& name : names) {
     SCOPED_TRACE("device backend " + name);
     body(name);

@@ -658,6 +658,16 @@ std::string describe_scene(const fsi::Scene& scene) {
     os << " for the " << capacity << " particles reserved (" << (capacity - total) << " for daughters; on_full: "
        << (scene.capacity.error_when_full ? "error" : "warn") << ")";
   os << "\n";
+  {
+    const sph::DeviceMemory& d = s.device_memory;
+    const double dev_mib = double(capacity) * double(d.total()) / (1024.0 * 1024.0);
+    os << "device memory    " << d.total() << " bytes/particle on a GPU, about " << sig(dev_mib, 3) << " MiB (fields "
+       << d.fields << ", sort " << d.sort;
+    if (d.splitting) os << ", splitting " << d.splitting;
+    if (d.open_boundaries) os << ", open boundaries " << d.open_boundaries;
+    if (d.structures) os << ", structures " << d.structures;
+    os << ")\n";
+  }
   os << "end time         " << scene.end_time << " s, output every " << scene.output.every << " s\n";
   for (const auto& w : s.warnings) os << w << "\n";
   return os.str();

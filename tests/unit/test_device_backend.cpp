@@ -283,4 +283,24 @@ TEST(DeviceBackend, HostTrafficPerStepDoesNotGrowWithParticlesWithAFreeBody) {
   });
 }
 
+// What the backend holds against sph::device_memory_per_particle, which `turbid check` prints: the
+// 3D dam break of the throughput benchmark, coarse (fields, sort). Bound 15%: Thrust's own small
+// blocks and the cell arrays are outside the plan.
+TEST(DeviceBackend, DeviceMemoryPerParticleIsWhatTurbidCheckSays) {
+  turbid::testing::for_each_device_backend([](const std::string& device) {
+    fsi::Scene scene = tools::read_scene_file(std::string(TURBID_SOURCE_DIR) + "/scenes/dam_break_obstacle_3d.yaml");
+    scene.output.vtk = false;
+    scene.particle_spacing = 0.03;
+    fsi::Simulation sim(scene, on(device));
+    sim.start();
+    for (int k = 0; k < 3; ++k) sim.step();
+    const double capacity = double(std::max(sim.store().capacity(), sim.store().size()));
+    const double held = double(sim.backend().device_bytes()) / capacity;
+    const sph::DeviceMemory& plan = sim.summary().device_memory;
+    std::printf("[ measured ] %s, 3D dam break, %zu particles: %.1f bytes/particle held, %zu planned (fields %zu, sort %zu)\n",
+                device.c_str(), sim.store().size(), held, plan.total(), plan.fields, plan.sort);
+    EXPECT_NEAR(held, double(plan.total()), 0.15 * double(plan.total()));
+  });
+}
+
 }  // namespace

@@ -3,7 +3,8 @@
 // CUDA backend with a GPU, the device-omp build of the same code where compiled: CI runs that one;
 // tests/device_backends.hpp), compared particle by particle (by id) in position, velocity and
 // density; the dam break also with the laminar viscosity and no-slip DBC or mDBC walls (the
-// ghost-node passes). Skipped with neither.
+// ghost-node passes), with the artificial viscosity on the walls' normal and with the wall
+// function; and the pipe on springs (moving bodies). Skipped with neither.
 //
 // The bound, and why. Both backends compute in float32 with the same formulas; they differ in the
 // association of sums and in fused multiply-adds, i.e. by rounding, about one float ulp per
@@ -172,5 +173,28 @@ TEST(BackendParity, DamBreak2DNoSlipDbcWallsOver2000Steps) {
 TEST(BackendParity, DamBreak2DNoSlipMdbcWallsOver2000Steps) {
   expect_parity("dam_break_2d", laminar_no_slip<fsi::BoundaryKind::mdbc>, " (laminar, mDBC walls, velocity: no_slip)");
 }
+
+// The wall treatments of the impact issue (#25): the artificial viscosity on the wall's normal
+// approach (mDBC walls, the impact scene's choice), and the log-law wall function with laminar
+// viscosity on no-slip mDBC walls.
+void mdbc_walls_normal(fsi::Scene& s) {
+  s.numerics.boundary = fsi::BoundaryKind::mdbc;
+  s.numerics.artificial_wall_normal = true;
+}
+void laminar_wall_function(fsi::Scene& s) {
+  laminar_no_slip<fsi::BoundaryKind::mdbc>(s);
+  s.numerics.wall_function = true;
+  s.numerics.wall_roughness = 1e-4;
+}
+TEST(BackendParity, DamBreak2DArtificialViscosityOnTheWallNormalOver2000Steps) {
+  expect_parity("dam_break_2d", mdbc_walls_normal, " (mDBC walls, viscosity walls: normal)");
+}
+TEST(BackendParity, DamBreak2DWallFunctionOver2000Steps) {
+  expect_parity("dam_break_2d", laminar_wall_function, " (laminar, mDBC no-slip walls, wall function k_s = 0.1 mm)");
+}
+
+// A scene of tools/device_check: the pipe on springs struck by a dam break (moving bodies: the
+// springs integrated on the host, loads summed and particles placed on the device).
+TEST(BackendParity, PipeOnSpringsOver2000Steps) { expect_parity("pipeline_springs_dam_break_2d"); }
 
 }  // namespace

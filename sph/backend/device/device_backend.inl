@@ -147,16 +147,25 @@ constexpr std::uint32_t kHealthy = 0xffffffffu;
 // i for an unhealthy particle, kHealthy otherwise; the minimum is the CPU's "first" particle.
 template <int D>
 struct HealthPass {
+  // Only the rest densities of PhysicsParams: this functor runs inside Thrust's reduction kernels,
+  // which copy it to local memory per thread (the whole PhysicsParams made that 2.5 KB).
+  using RestDensity = decltype(TaitEos{}.rest_density);
   ParticleView<D> P;
-  PhysicsParams prm;
   double limit;
+  RestDensity rest[kMaxMaterials];
+  int wall_material;
+  static HealthPass make(const ParticleView<D>& P, const PhysicsParams& prm, double limit) {
+    HealthPass h{P, limit, {}, prm.wall_material};
+    for (int m = 0; m < kMaxMaterials; ++m) h.rest[m] = prm.materials[m].eos.rest_density;
+    return h;
+  }
   TURBID_HD bool healthy(std::uint32_t i) const {
     for (int k = 0; k < D; ++k)
       if (!finite(P.position[i][k]) || !finite(P.velocity[i][k]) || !finite(P.acceleration[i][k])) return false;
     // Walls and structures hold density in the wall material's units, buffers in their own.
     const bool own = P.kind[i] == std::uint8_t(Kind::fluid) || P.kind[i] == std::uint8_t(Kind::buffer);
-    const int m = own ? P.material[i] : prm.wall_material;
-    const double ratio = double(P.density[i]) / prm.materials[m].eos.rest_density - 1.0;
+    const int m = own ? P.material[i] : wall_material;
+    const double ratio = double(P.density[i]) / rest[m] - 1.0;
     return finite(ratio) && (ratio < 0 ? -ratio : ratio) <= limit;
   }
   TURBID_HD std::uint32_t operator()(std::uint32_t i) const { return healthy(i) ? kHealthy : i; }
@@ -489,6 +498,15 @@ class DeviceBackend final : public Backend {
 
   std::uint64_t host_device_bytes() const override { return moved_; }
   std::size_t temporary_allocations() const override { return cache_.allocations(); }
+  std::size_t device_bytes() const override {
+    std::size_t b = cache_.bytes();
+    for (const DeviceBuffer& f : fields_) b += f.bytes();
+    for (const DeviceBuffer* x : {&scratch_, &cell_start_, &keys_, &order_, &fluid_before_, &put_backs_, &split_slots_,
+                                  &split_rule_, &split_first_, &relax_zone_, &relax_shift_, &placements_, &zone_crossing_,
+                                  &body_list_})
+      b += x->bytes();
+    return b;
+  }
 
   std::size_t pair_count() override { return params_.dimensions == 2 ? count_pairs<2>() : count_pairs<3>(); }
 
@@ -822,10 +840,8 @@ class DeviceBackend final : public Backend {
     const std::uint32_t n = n_;
     relax_zone_.ensure(capacity_ * sizeof(std::uint8_t));
     relax_shift_.ensure(capacity_ * sizeof(Vec<D>));
-    relax_moment_.ensure(capacity_ * sizeof(RelaxMoment));
     std::uint8_t* zone = relax_zone_.as<std::uint8_t>();
     Vec<D>* shift = relax_shift_.as<Vec<D>>();
-    RelaxMoment* moment = relax_moment_.as<RelaxMoment>();
     const ParticleView<D> P = view<D>();
     const GridView<D> G = grid<D>();
     std::size_t zone_count = 0;
@@ -835,10 +851,7 @@ class DeviceBackend final : public Backend {
       launch("SplitRelaxZonePass", n, SplitRelaxZonePass<D, K, U>{P, G, params_, zone});
       for (int it = 0; it < rules.relax_iterations; ++it) {
         launch("SplitRelaxShiftPass", n, SplitRelaxShiftPass<D, K, U>{P, G, params_, zone, shift, rules.relax_strength});
-        launch("RelaxMomentPass", n, RelaxMomentPass<D>{zone, P.mass, shift, moment});
-        const RelaxMoment m =
-            thrust::reduce(policy(cache_), moment, moment + n, RelaxMoment{0, 0, {0, 0, 0}}, SumRelaxMoment{});
-        moved_ += sizeof(RelaxMoment);
+        const RelaxMoment m = reduce(n, RelaxMomentPass<D>{zone, P.mass, shift}, RelaxMoment{0, 0, {0, 0, 0}}, SumRelaxMoment{});
         zone_count = std::size_t(m.count);
         if (zone_count == 0) return;
         Vec<D> mean;
@@ -861,7 +874,7 @@ class DeviceBackend final : public Backend {
   std::optional<HealthIssue> health_impl(double limit) {
     const std::uint32_t n = n_;
     if (n == 0) return std::nullopt;
-    const std::uint32_t i = reduce(n, HealthPass<D>{view<D>(), params_, limit}, kHealthy, thrust::minimum<std::uint32_t>());
+    const std::uint32_t i = reduce(n, HealthPass<D>::make(view<D>(), params_, limit), kHealthy, thrust::minimum<std::uint32_t>());
     if (i == kHealthy) return std::nullopt;
     return describe_unhealthy<D>(i);
   }
@@ -871,7 +884,7 @@ class DeviceBackend final : public Backend {
     StepCheck c;
     if (n_ == 0) return c;
     const ParticleView<D> P = view<D>();
-    const StepReport r = reduce(n_, StepReportPass<D>{SpeedPass<D>{P}, HealthPass<D>{P, params_, limit}},
+    const StepReport r = reduce(n_, StepReportPass<D>{SpeedPass<D>{P}, HealthPass<D>::make(P, params_, limit)},
                                 StepReport{{0.f, 0.f}, kHealthy}, CombineStepReport{});
     if (r.bad != kHealthy) c.issue = describe_unhealthy<D>(r.bad);
     else c.stats = {std::sqrt(double(r.speed.v2)), std::sqrt(double(r.speed.a2))};
@@ -922,7 +935,7 @@ class DeviceBackend final : public Backend {
   DeviceBuffer fluid_before_;  // cell_count + 1: fluid particles in the cells before each cell
   DeviceBuffer put_backs_;     // one counter: WallConstraintPass's put-backs since bind
   DeviceBuffer split_slots_, split_rule_, split_first_;  // splitting only, from the first split
-  DeviceBuffer relax_zone_, relax_shift_, relax_moment_;  // relaxation after a split, from the first one
+  DeviceBuffer relax_zone_, relax_shift_;  // relaxation after a split, from the first one
   DeviceBuffer placements_;  // moving structures' BodyPlacement, one per structure
   DeviceBuffer zone_crossing_;  // open boundaries: ZoneCrossing per particle
   DeviceBuffer body_list_;      // moving structures: indices of structure particles (body_loads)

@@ -146,6 +146,13 @@ class CachingAllocator {
   }
   // Blocks allocated from the device since construction (a test checks that steady steps add none).
   std::size_t allocations() const { return allocations_; }
+  // Bytes held, in use or cached.
+  std::size_t bytes() const {
+    std::size_t b = 0;
+    for (auto& [bytes, p] : free_) b += bytes;
+    for (auto& [p, bytes] : used_) b += bytes;
+    return b;
+  }
 
  private:
   std::multimap<std::size_t, char*> free_;  // by size
@@ -186,8 +193,11 @@ inline void use_host_threads(int requested) {
 constexpr unsigned kBlock = 256;
 inline unsigned blocks_for(std::size_t n) { return unsigned((n + kBlock - 1) / kBlock); }
 
+// The functor (with its PhysicsParams, about 0.8 KB) stays in the kernel's parameter space:
+// __grid_constant__ lets the passes index it at run time (materials[m], zones[k]) without a copy
+// to local memory per thread (sm_70 and later; we build for sm_90).
 template <class F, class Index>
-__global__ void run_pass(F f, Index n) {
+__global__ void run_pass(const __grid_constant__ F f, Index n) {
   const std::size_t i = std::size_t(blockIdx.x) * blockDim.x + threadIdx.x;
   if (i < n) f(Index(i));
 }
@@ -196,7 +206,7 @@ __global__ void run_pass(F f, Index n) {
 // multiprocessor (3: <= 80 registers a thread, 4: <= 64). The 3D pair passes need 84-108 registers
 // unbounded, which leaves 2 blocks (25% occupancy) on sm_90 for loops that wait on loads.
 template <class F, int MinBlocks>
-__global__ void __launch_bounds__(kBlock, MinBlocks) run_pass_bounded(F f, std::uint32_t n) {
+__global__ void __launch_bounds__(kBlock, MinBlocks) run_pass_bounded(const __grid_constant__ F f, std::uint32_t n) {
   const std::size_t i = std::size_t(blockIdx.x) * blockDim.x + threadIdx.x;
   if (i < n) f(std::uint32_t(i));
 }
