@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -844,6 +845,11 @@ nlohmann::json run_scene(const RunRequest& request) {
   if (scene.numerics.wall_function)
     report["wall_treatment"]["wall_function"] = {{"law", "log"}, {"roughness_m", scene.numerics.wall_roughness}};
   report["threads"] = sim.threads();
+  {
+    // The OpenMP wait policy the run had (turbid sets passive when none is given; docs/performance.md).
+    const char* policy = std::getenv("OMP_WAIT_POLICY");
+    report["omp_wait_policy"] = policy ? policy : "default";
+  }
   report["git_revision"] = TURBID_GIT_REVISION;
   report["version"] = TURBID_VERSION;
   report["units"] = {{"simulated_time", "s"}, {"wall_seconds", "s"}, {"particle_steps_per_second", "1/s"},

@@ -1,8 +1,11 @@
 // The `turbid` command: run, check and info.
 #include <omp.h>
 
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <optional>
 
@@ -21,12 +24,34 @@ bool located(const std::string& message) {
   return at != std::string::npos && at < message.find(' ');
 }
 
+// OpenMP threads that spin while they wait (libgomp's default when OMP_WAIT_POLICY is unset: a
+// spin of about 300,000 iterations before sleeping, at every barrier) take the cores from other
+// jobs on a shared machine, and the run collapses: 20 times slower beside one other job (issue
+// #24, docs/performance.md "OpenMP on a shared machine"). libgomp reads the policy once, when it is
+// loaded, so a run started without one is restarted here with OMP_WAIT_POLICY=passive. A policy
+// (or GOMP_SPINCOUNT) set by the user is kept: `active` gains a few percent on a machine of one's own.
+void prefer_passive_openmp(char** argv) {
+  if (std::getenv("OMP_WAIT_POLICY") != nullptr || std::getenv("GOMP_SPINCOUNT") != nullptr) return;
+  if (setenv("OMP_WAIT_POLICY", "passive", 1) != 0) return;
+  setenv("TURBID_OMP_WAIT_POLICY_SET", "1", 1);  // `turbid info` says who chose it
+  execv("/proc/self/exe", argv);
+  // The restart failed: go on with the runtime's default (the variable is set, too late to count).
+}
+
+const char* omp_wait_policy_text() {
+  const char* p = std::getenv("OMP_WAIT_POLICY");
+  if (p == nullptr) return std::getenv("GOMP_SPINCOUNT") ? "the runtime's, GOMP_SPINCOUNT set" : "the runtime's default";
+  if (std::getenv("TURBID_OMP_WAIT_POLICY_SET") != nullptr) return "passive (turbid's default; set OMP_WAIT_POLICY to choose)";
+  return p;
+}
+
 int cmd_info() {
   std::printf("turbid %s (git %s, %s build)\n", TURBID_VERSION, TURBID_GIT_REVISION, TURBID_BUILD_TYPE);
   std::printf("precision        particle fields float32, conservation sums float64\n");
   std::printf("backends         cpu (OpenMP, %d threads available)", omp_get_max_threads());
   std::printf("%s", turbid::sph::cuda_backend_compiled() ? ", cuda (compiled in)" : "");
   std::printf("%s\n", turbid::sph::omp_device_backend_compiled() ? ", device-omp (compiled in)" : "");
+  std::printf("openmp wait      %s\n", omp_wait_policy_text());
   std::printf("rigid bodies     built-in (motion: free)%s\n",
               turbid::fsi::bullet_available() ? ", Bullet double precision (motion: bullet)"
                                               : "; no Bullet (motion: bullet refused; install libbullet-dev and rebuild)");
@@ -40,6 +65,7 @@ int cmd_info() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  prefer_passive_openmp(argv);
   CLI::App app{"turbid: weakly compressible SPH with fluid-structure interaction"};
   // At most one command; none is answered below (an unknown word is then named by CLI11 as an
   // argument it did not expect, instead of "A subcommand is required").
