@@ -1424,8 +1424,7 @@ void Simulation::build_particles() {
   }
   summary_.smoothing_length = params_.smoothing_length;
   for (int m = 0; m < params_.material_count; ++m) summary_.sound_speed.push_back(params_.materials[m].sound_speed);
-  // Store fields plus the neighbour search's keys, order and permutation scratch.
-  summary_.bytes_per_particle = store_.bytes_per_particle() + 12;
+  summary_.cpu_memory = sph::cpu_memory_per_particle(store_, params_, scene_.particle_spacing, !scene_.transitions.empty());
   summary_.device_memory = sph::device_memory_per_particle(store_, params_, !scene_.transitions.empty());
 }
 

@@ -14,7 +14,7 @@
 #include "fsi/scene.hpp"
 #include "fsi/wall_penetration.hpp"
 #include "sph/backend.hpp"
-#include "sph/backend/device/device_memory.hpp"
+#include "sph/backend/memory_plan.hpp"
 #include "sph/fields.hpp"
 #include "sph/particle_store.hpp"
 #include "sph/solver.hpp"
@@ -54,8 +54,9 @@ struct WorldSummary {
   std::vector<std::size_t> particles_per_material;
   double smoothing_length = 0;     // [m]
   std::vector<double> sound_speed; // per material [m/s]
-  std::size_t bytes_per_particle = 0;
-  // On a device backend (GPU, or device-omp): per particle of capacity (sph/backend/device/device_memory.hpp).
+  // On the CPU backend, per particle (sph/backend/memory_plan.hpp): fields, sort, neighbour list.
+  sph::CpuMemory cpu_memory;
+  // On a device backend (GPU, or device-omp): per particle of capacity (sph/backend/memory_plan.hpp).
   sph::DeviceMemory device_memory;
   sph::Domain domain;
   // "file:line:col: warning: ..." for layouts a user may mean but should know about (overlapping

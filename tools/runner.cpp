@@ -653,11 +653,25 @@ std::string describe_scene(const fsi::Scene& scene) {
        << " Pa, " << (t.interface_only ? "at interfaces" : "anywhere") << ", " << (1 << scene.dimensions)
        << " daughters (h/2), up to " << t.levels << (t.levels == 1 ? " level" : " levels") << "\n";
   const std::size_t capacity = fsi::particle_capacity(scene, total);
-  const double mib = double(capacity) * double(s.bytes_per_particle) / (1024.0 * 1024.0);
-  os << "memory           " << s.bytes_per_particle << " bytes/particle, about " << sig(mib, 3) << " MiB";
+  const sph::CpuMemory& c = s.cpu_memory;
+  const double mib = double(capacity) * double(c.total()) / (1024.0 * 1024.0);
+  os << "memory           " << c.total() << " bytes/particle on the CPU (fields " << c.fields << ", neighbour list "
+     << c.neighbour_list << ", sort " << c.sort;
+  if (c.splitting) os << ", splitting " << c.splitting;
+  if (c.implicit) os << ", implicit viscosity " << c.implicit;
+  os << "), about " << sig(mib, 3) << " MiB";
   if (capacity > total)
     os << " for the " << capacity << " particles reserved (" << (capacity - total) << " for daughters; on_full: "
        << (scene.capacity.error_when_full ? "error" : "warn") << ")";
+  {
+    // The largest run of this scene's kind this machine holds (its physical memory, all of it).
+    const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+    if (pages > 0 && page > 0) {
+      const double bytes = double(pages) * double(page);
+      os << "; this machine's " << sig(bytes / double(1ull << 30), 3) << " GiB hold about "
+         << sig(bytes / double(c.total()) / 1e6, 2) << " million particles";
+    }
+  }
   os << "\n";
   {
     const sph::DeviceMemory& d = s.device_memory;
@@ -667,6 +681,7 @@ std::string describe_scene(const fsi::Scene& scene) {
     if (d.splitting) os << ", splitting " << d.splitting;
     if (d.open_boundaries) os << ", open boundaries " << d.open_boundaries;
     if (d.structures) os << ", structures " << d.structures;
+    if (d.implicit) os << ", implicit viscosity " << d.implicit;
     os << ")\n";
   }
   os << "end time         " << scene.end_time << " s, output every " << scene.output.every << " s\n";

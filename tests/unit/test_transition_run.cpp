@@ -231,12 +231,16 @@ TEST(TransitionRun, CheckPrintsTheReservedCapacityAndItsMemory) {
                                std::to_string(capacity - n0) + " for daughters; on_full: warn)";
   EXPECT_NE(text.find(reserved), std::string::npos) << text;
   EXPECT_NE(text.find("transition       debris -> turbidity where sqrt(J2) > 20.1 Pa"), std::string::npos) << text;
-  // Memory: capacity x bytes per particle (store fields + neighbour-search scratch), in MiB.
+  // Memory: capacity x the CPU backend's bytes per particle (fields, neighbour list, sort,
+  // splitting, sph/backend/memory_plan.hpp), in MiB.
   const auto at = text.find("about ");
   ASSERT_NE(at, std::string::npos) << text;
   const double mib = std::stod(text.substr(at + 6));
-  const double expected = double(capacity) * double(sim.summary().bytes_per_particle) / (1024.0 * 1024.0);
+  const sph::CpuMemory& cpu = sim.summary().cpu_memory;
+  const double expected = double(capacity) * double(cpu.total()) / (1024.0 * 1024.0);
   EXPECT_NEAR(mib, expected, 5e-3 * expected) << "printed with 3 significant digits";
-  EXPECT_GT(sim.summary().bytes_per_particle, sim.store().bytes_per_particle());
+  EXPECT_EQ(cpu.fields, sim.store().bytes_per_particle());
+  EXPECT_GT(cpu.neighbour_list, cpu.fields) << "the list is most of it";
+  EXPECT_GT(cpu.splitting, 0u) << "the scene has a transition";
   fs::remove_all(dir);
 }

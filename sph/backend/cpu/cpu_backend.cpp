@@ -9,9 +9,11 @@
 #include <vector>
 
 #include "sph/backend.hpp"
+#include "sph/backend/memory_plan.hpp"
 #include "sph/boundary_passes.hpp"
 #include "sph/dispatch.hpp"
 #include "sph/implicit_viscosity.hpp"
+#include "sph/implicit_viscosity_solve.hpp"
 #include "sph/passes.hpp"
 #include "sph/splitting.hpp"
 
@@ -149,110 +151,53 @@ class CpuBackend final : public Backend {
     return total;
   }
 
-  // Jacobi-preconditioned conjugate gradients on the implicit viscous system (see
-  // sph/implicit_viscosity.hpp), in the inner product weighted by particle mass, in which the
-  // system is symmetric; starts from the current velocities.
+  // The implicit viscous solve (sph/implicit_viscosity_solve.hpp), with OpenMP loops and dot
+  // products summed in blocks of fixed order.
+  struct Exec {
+    CpuBackend* backend;
+    template <class F>
+    void run(std::uint32_t n, const F& f) {
+      parallel_for(n, f);
+    }
+    template <class F>
+    double sum(std::uint32_t n, const F& f) {
+      return backend->fixed_order_sum(n, f);
+    }
+  };
+
   template <int D>
   ViscousSolve viscosity_impl(Real dt, Real share, bool first_half) {
     const ParticleView<D> P = view<D>();
     const GridView<D> G = grid<D>();
     const std::uint32_t n = P.count;
-    ViscousSolve out;
     std::vector<Vec<D>>* cg_ = cg_vectors<D>();
-    std::vector<Vec<D>>& x = cg_[0];
-    std::vector<Vec<D>>& r = cg_[1];
-    std::vector<Vec<D>>& z = cg_[2];
-    std::vector<Vec<D>>& p = cg_[3];
-    std::vector<Vec<D>>& q = cg_[4];
     for (int k = 0; k < 8; ++k) cg_[k].resize(n);
-    Vec<D>* diag = cg_[5].data();
-    // The full-stress form (sph/full_stress.hpp): renormalisation, gradient and Q per particle, the
-    // pair part of dR/du, and the acceleration of an evaluation.
-    const bool full = params_.full_stress;
-    std::vector<Mat<D>>* fs = full_stress_tensors<D>();
-    if (full) {
-      for (int k = 0; k < 3; ++k) fs[k].resize(n);
+    ViscousWork<D> w;
+    w.x = cg_[0].data();
+    w.r = cg_[1].data();
+    w.z = cg_[2].data();
+    w.p = cg_[3].data();
+    w.q = cg_[4].data();
+    w.diag = cg_[5].data();
+    w.direct = cg_[6].data();
+    w.full_dR = cg_[7].data();
+    if (params_.full_stress) {
+      // The full-stress form (sph/full_stress.hpp): renormalisation, gradient and Q per particle.
+      std::vector<Mat<D>>* fs = full_stress_tensors<D>();
+      for (int k = 0; k < 3; ++k) {
+        fs[k].resize(n);
+        w.fs[k] = fs[k].data();
+      }
       carrier_mu_.resize(n);
+      w.carrier = carrier_mu_.data();
     }
-    Vec<D>* direct = cg_[6].data();
-    Vec<D>* full_dR = full ? cg_[7].data() : nullptr;
-    Real* carrier = carrier_mu_.data();
-    // z = r / diag, component by component (the Jacobi preconditioner)
-    const auto precondition = [&](std::uint32_t i) {
-      for (int c = 0; c < D; ++c) z[i][c] = (Real(1) / diag[i][c]) * r[i][c];
-    };
     const NeighbourList L = list(false);
-    const auto dot = [&](const std::vector<Vec<D>>& a, const std::vector<Vec<D>>& b) {
-      return fixed_order_sum(n, [&](std::uint32_t i) {
-        return in_system<D>(diag, i) ? double(P.mass[i]) * double(turbid::sph::dot(a[i], b[i])) : 0.0;
-      });
-    };
+    ViscousSolve out;
+    Exec ex{this};
     dispatch_kernel<D>(params_, [&](auto kernel_tag, auto uniform_tag) {
       using K = typename decltype(kernel_tag)::type;
       constexpr bool U = decltype(uniform_tag)::value;
-      // dR/du of the full-stress form (sph/full_stress.hpp) into full_dR; linear in (u, known):
-      // dR(x; known) = dR(x; 0) + dR(0; known).
-      const auto full_eval = [&](const Vec<D>* u, bool known, bool structures = false) {
-        parallel_for(n, FullStressGradientPass<D, K, U>{P, G, params_, L, u, known, carrier, fs[0].data(), fs[1].data()});
-        parallel_for(n, FullStressStressPass<D, K, U>{P, G, params_, L, u, known, carrier, fs[0].data(), fs[1].data(),
-                                                       fs[2].data(), direct});
-        parallel_for(n, FullStressForcePass<D, K, U>{P, G, params_, L, carrier, fs[2].data(), direct, structures, full_dR});
-      };
-      const auto apply = [&](const std::vector<Vec<D>>& u, std::vector<Vec<D>>& out) {
-        if (full) full_eval(u.data(), false);
-        parallel_for(n, ViscousApplyPass<D, K, U>{P, G, params_, L, dt, diag, u.data(), full_dR, out.data()});
-      };
-      parallel_for(n, ViscousSystemPass<D, K, U>{P, G, params_, L, dt, diag, r.data()});  // r = b for now
-      if (full) {
-        parallel_for(n, FullStressSetupPass<D, K, U>{P, G, params_, L, carrier, fs[0].data()});
-        full_eval(nullptr, true);  // the boundary velocities' part goes to the right-hand side
-        parallel_for(n, [&](std::uint32_t i) {
-          if (in_system<D>(diag, i)) r[i] -= (dt / P.mass[i]) * full_dR[i];
-        });
-      }
-      parallel_for(n, [&](std::uint32_t i) { x[i] = P.velocity[i]; });
-      apply(x, q);
-      const double b_norm = std::sqrt(dot(r, r));
-      parallel_for(n, [&](std::uint32_t i) {
-        if (in_system<D>(diag, i)) {
-          r[i] -= q[i];
-          precondition(i);
-        } else {
-          r[i] = z[i] = Vec<D>::zero();
-        }
-        p[i] = z[i];
-      });
-      double rz = dot(r, z);
-      double res = b_norm > 0 ? std::sqrt(dot(r, r)) / b_norm : 0.0;
-      const double tol = double(params_.implicit_tolerance);
-      int k = 0;
-      while (res > tol && k < params_.implicit_max_iterations) {
-        apply(p, q);
-        const double pq = dot(p, q);
-        if (!(pq > 0)) break;
-        const Real alpha = Real(rz / pq);
-        parallel_for(n, [&](std::uint32_t i) {
-          if (!in_system<D>(diag, i)) return;
-          x[i] += alpha * p[i];
-          r[i] -= alpha * q[i];
-          precondition(i);
-        });
-        ++k;
-        res = std::sqrt(dot(r, r)) / b_norm;
-        const double rz_next = dot(r, z);
-        const Real beta = Real(rz_next / rz);
-        rz = rz_next;
-        parallel_for(n, [&](std::uint32_t i) {
-          if (in_system<D>(diag, i)) p[i] = z[i] + beta * p[i];
-        });
-      }
-      out.iterations = k;
-      out.residual = res;
-      out.converged = res <= tol;
-      if (full) full_eval(x.data(), true, P.viscous_load != nullptr);  // the update's and the reactions' evaluation
-      parallel_for(n, ViscousUpdatePass<D, K, U>{P, G, params_, L, dt, diag, x.data(), full_dR});
-      if (P.viscous_load)
-        parallel_for(n, ViscousReactionPass<D, K, U>{P, G, params_, diag, x.data(), share, first_half, full_dR});
+      out = solve_implicit_viscosity<D, K, U>(ex, P, G, L, params_, dt, share, first_half, w);
     });
     return out;
   }
@@ -426,12 +371,7 @@ class CpuBackend final : public Backend {
     if (!record && !list_valid_) return L;
     const std::size_t n = store_->size();
     if (record) {
-      if (list_stride_ == 0) {
-        // 1.5 x the lattice particles in the support sphere (circle in 2D), rounded up to 8.
-        const double r = 2.0 * params_.max_smoothing_length / spacing_estimate();
-        const double inside = params_.dimensions == 2 ? 3.14159265 * r * r : 4.18879 * r * r * r;
-        list_stride_ = (std::uint32_t(1.5 * inside) + 15u) & ~7u;
-      }
+      if (list_stride_ == 0) list_stride_ = neighbour_list_stride(params_, spacing_estimate());
       if (list_entries_.size() < n * list_stride_) list_entries_.resize(n * list_stride_);
       if (list_count_.size() < n) list_count_.resize(n);
     }

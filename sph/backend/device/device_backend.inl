@@ -37,6 +37,7 @@
 #include "sph/backend/device/device_system.hpp"
 #include "sph/boundary_passes.hpp"
 #include "sph/dispatch.hpp"
+#include "sph/implicit_viscosity_solve.hpp"
 #include "sph/passes.hpp"
 #include "sph/splitting.hpp"
 
@@ -503,7 +504,7 @@ class DeviceBackend final : public Backend {
     for (const DeviceBuffer& f : fields_) b += f.bytes();
     for (const DeviceBuffer* x : {&scratch_, &cell_start_, &keys_, &order_, &fluid_before_, &put_backs_, &split_slots_,
                                   &split_rule_, &split_first_, &relax_zone_, &relax_shift_, &placements_, &zone_crossing_,
-                                  &body_list_})
+                                  &body_list_, &viscous_work_, &full_stress_work_})
       b += x->bytes();
     return b;
   }
@@ -546,6 +547,60 @@ class DeviceBackend final : public Backend {
     pass.body_count = body_count;
     pass.move = move;
     launch(D == 2 ? "PlaceBodiesPass<2>" : "PlaceBodiesPass<3>", n_, pass);
+  }
+
+  // The implicit viscous solve (sph/implicit_viscosity_solve.hpp, the CPU's algorithm): its passes
+  // launched here, its dot products Thrust reductions in double (one value back each).
+  bool supports_implicit_viscosity() const override { return true; }
+  ViscousSolve solve_viscosity(double dt, double share, bool first_half) override {
+    return params_.dimensions == 2 ? viscosity_impl<2>(Real(dt), Real(share), first_half)
+                                   : viscosity_impl<3>(Real(dt), Real(share), first_half);
+  }
+
+  template <int D>
+  struct Exec {
+    DeviceBackend* backend;
+    template <class F>
+    void run(std::uint32_t n, const F& f) {
+      launch_pairs<D>("implicit viscosity pass", n, f);
+    }
+    template <class F>
+    double sum(std::uint32_t n, const F& f) {
+      return backend->reduce(n, f, 0.0, thrust::plus<double>());
+    }
+  };
+
+  template <int D>
+  ViscousSolve viscosity_impl(Real dt, Real share, bool first_half) {
+    const ParticleView<D> P = view<D>();
+    const GridView<D> G = grid<D>();
+    // Work arrays for the whole capacity, from the first solve (scenes without it hold none).
+    const std::size_t cap = capacity_;
+    viscous_work_.ensure(8 * cap * sizeof(Vec<D>));
+    Vec<D>* cg = viscous_work_.as<Vec<D>>();
+    ViscousWork<D> w;
+    w.x = cg;
+    w.r = cg + cap;
+    w.z = cg + 2 * cap;
+    w.p = cg + 3 * cap;
+    w.q = cg + 4 * cap;
+    w.diag = cg + 5 * cap;
+    w.direct = cg + 6 * cap;
+    w.full_dR = cg + 7 * cap;
+    if (params_.full_stress) {
+      full_stress_work_.ensure(3 * cap * sizeof(Mat<D>) + cap * sizeof(Real));
+      Mat<D>* fs = full_stress_work_.as<Mat<D>>();
+      for (int k = 0; k < 3; ++k) w.fs[k] = fs + std::size_t(k) * cap;
+      w.carrier = reinterpret_cast<Real*>(fs + 3 * cap);
+    }
+    ViscousSolve out;
+    Exec<D> ex{this};
+    dispatch_kernel<D>(params_, [&](auto kernel_tag, auto uniform_tag) {
+      using K = typename decltype(kernel_tag)::type;
+      constexpr bool U = decltype(uniform_tag)::value;
+      out = solve_implicit_viscosity<D, K, U>(ex, P, G, NeighbourList{}, params_, dt, share, first_half, w);
+    });
+    return out;
   }
 
   bool supports_splitting() const override { return true; }
@@ -691,6 +746,8 @@ class DeviceBackend final : public Backend {
     if (ids_.effective_viscosity >= 0) v.effective_viscosity = static_cast<Real*>(field(ids_.effective_viscosity));
     if (ids_.shear_stress >= 0) v.shear_stress = static_cast<Real*>(field(ids_.shear_stress));
     if (ids_.split_fresh >= 0) v.split_fresh = static_cast<std::uint8_t*>(field(ids_.split_fresh));
+    if (ids_.viscous_load >= 0) v.viscous_load = static_cast<Vec<D>*>(field(ids_.viscous_load));
+    if (ids_.viscous_pending >= 0) v.viscous_pending = static_cast<Vec<D>*>(field(ids_.viscous_pending));
     v.count = n_;
     return v;
   }
@@ -939,6 +996,7 @@ class DeviceBackend final : public Backend {
   DeviceBuffer placements_;  // moving structures' BodyPlacement, one per structure
   DeviceBuffer zone_crossing_;  // open boundaries: ZoneCrossing per particle
   DeviceBuffer body_list_;      // moving structures: indices of structure particles (body_loads)
+  DeviceBuffer viscous_work_, full_stress_work_;  // implicit viscosity: the solve's arrays, from the first solve
   CachingAllocator cache_;   // Thrust's temporary storage
   std::uint64_t moved_ = 0;  // bytes copied between host and device since construction
 };
