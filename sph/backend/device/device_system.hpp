@@ -72,32 +72,23 @@ inline void device_free(void* p) noexcept {
 #endif
 }
 
-inline void copy_to_device(void* dst, const void* src, std::size_t bytes) {
+// Copies between the host and the device, or within the device (memcpy where they are one).
+enum class CopyKind { to_device, to_host, on_device };
+inline void device_copy(void* dst, const void* src, std::size_t bytes, CopyKind kind) {
   if (bytes == 0) return;
 #if TURBID_DEVICE_CUDA
-  TURBID_CUDA_CHECK(cudaMemcpy(dst, src, bytes, cudaMemcpyHostToDevice));
+  const cudaMemcpyKind k = kind == CopyKind::to_device ? cudaMemcpyHostToDevice
+                           : kind == CopyKind::to_host ? cudaMemcpyDeviceToHost
+                                                       : cudaMemcpyDeviceToDevice;
+  TURBID_CUDA_CHECK(cudaMemcpy(dst, src, bytes, k));
 #else
+  (void)kind;
   std::memcpy(dst, src, bytes);
 #endif
 }
-
-inline void copy_to_host(void* dst, const void* src, std::size_t bytes) {
-  if (bytes == 0) return;
-#if TURBID_DEVICE_CUDA
-  TURBID_CUDA_CHECK(cudaMemcpy(dst, src, bytes, cudaMemcpyDeviceToHost));
-#else
-  std::memcpy(dst, src, bytes);
-#endif
-}
-
-inline void copy_on_device(void* dst, const void* src, std::size_t bytes) {
-  if (bytes == 0) return;
-#if TURBID_DEVICE_CUDA
-  TURBID_CUDA_CHECK(cudaMemcpy(dst, src, bytes, cudaMemcpyDeviceToDevice));
-#else
-  std::memcpy(dst, src, bytes);
-#endif
-}
+inline void copy_to_device(void* dst, const void* src, std::size_t bytes) { device_copy(dst, src, bytes, CopyKind::to_device); }
+inline void copy_to_host(void* dst, const void* src, std::size_t bytes) { device_copy(dst, src, bytes, CopyKind::to_host); }
+inline void copy_on_device(void* dst, const void* src, std::size_t bytes) { device_copy(dst, src, bytes, CopyKind::on_device); }
 
 inline void clear_device(void* dst, std::size_t bytes) {
   if (bytes == 0) return;
@@ -259,26 +250,21 @@ void launch_pairs(const char* name, std::uint32_t n, const F& f) {
   launch(name, n, f);
 }
 
-// isfinite / isnan for float in code that runs on either side.
-TURBID_HD inline bool finite(float x) {
+// isfinite / isnan (float or double) in code that runs on either side.
+template <class T>
+TURBID_HD inline bool finite(T x) {
 #if defined(__CUDA_ARCH__)
   return ::isfinite(x);
 #else
   return std::isfinite(x);
 #endif
 }
-TURBID_HD inline bool is_nan(float x) {
+template <class T>
+TURBID_HD inline bool is_nan(T x) {
 #if defined(__CUDA_ARCH__)
   return ::isnan(x);
 #else
   return std::isnan(x);
-#endif
-}
-TURBID_HD inline bool finite(double x) {
-#if defined(__CUDA_ARCH__)
-  return ::isfinite(x);
-#else
-  return std::isfinite(x);
 #endif
 }
 
