@@ -830,7 +830,10 @@ Simulation::Simulation(Scene scene, const RunOptions& options) : scene_(std::mov
     // Moving bodies on CUDA passed CudaBodies.* (tests/unit/test_cuda_bodies.cpp) on an H200 on
     // 2026-12-04 (docs/performance.md, "GPU"), so 'auto' runs them there.
     if (!scene_.transitions.empty() && !backend->supports_splitting()) backend = sph::make_cpu_backend(options.threads);
-    if (params_.implicit_viscosity && !backend->supports_implicit_viscosity())
+    // The implicit viscous solve runs on the device backend since 2026-12-05, checked there only
+    // through its device-omp build (BackendParity.PipelineImpact*): until it has run on a GPU,
+    // 'auto' keeps such scenes (the default scene among them) on the CPU; --backend cuda runs them.
+    if (params_.implicit_viscosity && (!backend->supports_implicit_viscosity() || backend->name() == "cuda"))
       backend = sph::make_cpu_backend(options.threads);
     if ((free_bodies || prescribed) && !backend->supports_moving_bodies())
       backend = sph::make_cpu_backend(options.threads);
