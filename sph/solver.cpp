@@ -150,9 +150,8 @@ void Solver::lower_daughter_h(double h) {
 
 void Solver::check(const char* phase) {
   StepCheck c = backend_->check_step(time_params_.density_ratio_limit);
-  checked_stats_ = c.stats;
   if (auto& issue = c.issue) {
-    checked_stats_.reset();
+    checked_stats_.reset();  // stats of a state that failed its check: not for the next step
     std::ostringstream os;
     os << "numerical blow-up after " << phase << " " << steps_ << " (t = " << time_ << " s): particle id " << issue->id
        << " has " << issue->field << " = " << issue->value;
@@ -160,6 +159,7 @@ void Solver::check(const char* phase) {
       os << " (outside rest density x (1 +/- " << time_params_.density_ratio_limit << "))";
     throw BlowUp(os.str());
   }
+  checked_stats_ = c.stats;
 }
 
 }  // namespace turbid::sph

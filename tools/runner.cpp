@@ -861,9 +861,12 @@ nlohmann::json run_scene(const RunRequest& request) {
     report["wall_treatment"]["wall_function"] = {{"law", "log"}, {"roughness_m", scene.numerics.wall_roughness}};
   report["threads"] = sim.threads();
   {
-    // The OpenMP wait policy the run had (turbid sets passive when none is given; docs/performance.md).
+    // The OpenMP wait the run had (turbid sets passive with a spin of 300 when neither is given;
+    // docs/performance.md, "OpenMP on a shared machine").
     const char* policy = std::getenv("OMP_WAIT_POLICY");
     report["omp_wait_policy"] = policy ? policy : "default";
+    const char* spin = std::getenv("GOMP_SPINCOUNT");
+    report["gomp_spincount"] = spin ? spin : "default";
   }
   report["git_revision"] = TURBID_GIT_REVISION;
   report["version"] = TURBID_VERSION;

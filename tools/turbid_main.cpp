@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <iostream>
 #include <optional>
+#include <string>
 
 #include "fsi/bullet_world.hpp"
 #include "sph/backend.hpp"
@@ -25,24 +26,33 @@ bool located(const std::string& message) {
 }
 
 // OpenMP threads that spin while they wait (libgomp's default when OMP_WAIT_POLICY is unset: a
-// spin of about 300,000 iterations before sleeping, at every barrier) take the cores from other
-// jobs on a shared machine, and the run collapses: 20 times slower beside one other job (issue
-// #24, docs/performance.md "OpenMP on a shared machine"). libgomp reads the policy once, when it is
-// loaded, so a run started without one is restarted here with OMP_WAIT_POLICY=passive. A policy
-// (or GOMP_SPINCOUNT) set by the user is kept: `active` gains a few percent on a machine of one's own.
+// spin of about 300,000 iterations, some 3 ms, before sleeping, at every barrier) take the cores from
+// other jobs on a shared machine, and the run collapses: 20 times slower beside one other job (issue
+// #24, docs/performance.md "OpenMP on a shared machine"). Threads that sleep at once pay a wake-up
+// at every one of a step's parallel loops: a small scene ran 1.3 times slower than with a spin of
+// 300 iterations (about 3 us), which costs 2% beside a busy job. libgomp reads these once, when it
+// is loaded, so a run started with neither is restarted here with OMP_WAIT_POLICY=passive (what
+// other OpenMP runtimes read) and GOMP_SPINCOUNT=300 (libgomp's spin, which overrides the policy's).
+// A policy or spin count set by the user is kept: `active` gains a little on a machine of one's own.
+constexpr const char* kSpinCount = "300";
+
 void prefer_passive_openmp(char** argv) {
   if (std::getenv("OMP_WAIT_POLICY") != nullptr || std::getenv("GOMP_SPINCOUNT") != nullptr) return;
-  if (setenv("OMP_WAIT_POLICY", "passive", 1) != 0) return;
+  if (setenv("OMP_WAIT_POLICY", "passive", 1) != 0 || setenv("GOMP_SPINCOUNT", kSpinCount, 1) != 0) return;
   setenv("TURBID_OMP_WAIT_POLICY_SET", "1", 1);  // `turbid info` says who chose it
   execv("/proc/self/exe", argv);
-  // The restart failed: go on with the runtime's default (the variable is set, too late to count).
+  // The restart failed: go on with the runtime's default (the variables are set, too late to count).
 }
 
-const char* omp_wait_policy_text() {
+std::string omp_wait_policy_text() {
   const char* p = std::getenv("OMP_WAIT_POLICY");
-  if (p == nullptr) return std::getenv("GOMP_SPINCOUNT") ? "the runtime's, GOMP_SPINCOUNT set" : "the runtime's default";
-  if (std::getenv("TURBID_OMP_WAIT_POLICY_SET") != nullptr) return "passive (turbid's default; set OMP_WAIT_POLICY to choose)";
-  return p;
+  const char* spin = std::getenv("GOMP_SPINCOUNT");
+  if (std::getenv("TURBID_OMP_WAIT_POLICY_SET") != nullptr)
+    return std::string("passive after a spin of ") + kSpinCount +
+           " (turbid's default; set OMP_WAIT_POLICY or GOMP_SPINCOUNT to choose)";
+  std::string text = p ? p : "the runtime's default";
+  if (spin) text += std::string(", GOMP_SPINCOUNT=") + spin;
+  return text;
 }
 
 int cmd_info() {
@@ -51,7 +61,7 @@ int cmd_info() {
   std::printf("backends         cpu (OpenMP, %d threads available)", omp_get_max_threads());
   std::printf("%s", turbid::sph::cuda_backend_compiled() ? ", cuda (compiled in)" : "");
   std::printf("%s\n", turbid::sph::omp_device_backend_compiled() ? ", device-omp (compiled in)" : "");
-  std::printf("openmp wait      %s\n", omp_wait_policy_text());
+  std::printf("openmp wait      %s\n", omp_wait_policy_text().c_str());
   std::printf("rigid bodies     built-in (motion: free)%s\n",
               turbid::fsi::bullet_available() ? ", Bullet double precision (motion: bullet)"
                                               : "; no Bullet (motion: bullet refused; install libbullet-dev and rebuild)");
