@@ -289,7 +289,9 @@ struct NumericsSpec {
   double artificial_viscosity = 0.01;      // Monaghan alpha [-]
   // Artificial viscosity with boundary particles acts on the approach along the wall's normal only
   // (sph::PhysicsParams::wall_viscosity_normal); false: on the pair's approach, as between fluid.
-  bool artificial_wall_normal = false;
+  // Unset: along the normal with mDBC walls, the pair's with DBC (docs/choices.md, "Artificial
+  // viscosity at walls").
+  std::optional<bool> artificial_wall_normal;
   ViscousIntegration viscous_integration = ViscousIntegration::automatic;
   ViscousStress viscous_stress = ViscousStress::automatic;
   double cfl = 0.2;                        // Courant number for the acoustic and force limits [-]

@@ -739,7 +739,8 @@ sph::PhysicsParams physics_params(const Scene& scene) {
   p.wall_no_slip = scene.numerics.no_slip.value_or(p.full_stress);
   // Wall function (docs/choices.md, "Wall friction"): y below a tenth of the spacing is held there.
   p.wall_function = scene.numerics.wall_function;
-  p.wall_viscosity_normal = scene.numerics.viscosity == ViscosityKind::artificial && scene.numerics.artificial_wall_normal &&
+  p.wall_viscosity_normal = scene.numerics.viscosity == ViscosityKind::artificial &&
+                            scene.numerics.artificial_wall_normal.value_or(scene.numerics.boundary == BoundaryKind::mdbc) &&
                             (!scene.walls.empty() || !scene.structures.empty());
   p.wall_roughness_length = sph::Real(scene.numerics.wall_roughness / 30.0);
   p.wall_function_min_distance = sph::Real(0.1 * scene.particle_spacing);

@@ -325,17 +325,20 @@ TEST(SceneReader, WallFunctionIsReadWithItsRoughness) {
   }
 }
 
-// Artificial viscosity at walls: the pair's approach unless `walls: normal`; laminar viscosity has
-// no such key and says so at its place.
+// Artificial viscosity at walls: unset unless stated (the simulation then picks by the wall
+// treatment: tests/unit/test_wall_viscosity.cpp); laminar viscosity has no such key and says so at
+// its place.
 TEST(SceneReader, ArtificialViscosityAtWallsIsReadAndOnlyForArtificial) {
   const std::string head =
       "name: t\ndimensions: 2\nresolution: {particle_spacing: 0.01}\n"
       "time: {end: 0.1}\nmaterials: {water: {density: 1000}}\nfluids: [{material: water, box: {min: [0, 0], max: [0.1, 0.1]}}]\n";
-  EXPECT_FALSE(read_scene_string(head, "a.yaml").numerics.artificial_wall_normal);
-  EXPECT_TRUE(read_scene_string(head + "numerics: {viscosity: {type: artificial, alpha: 0.02, walls: normal}}\n", "b.yaml")
-                  .numerics.artificial_wall_normal);
-  EXPECT_FALSE(read_scene_string(head + "numerics: {viscosity: {type: artificial, walls: pair}}\n", "c.yaml")
-                   .numerics.artificial_wall_normal);
+  EXPECT_FALSE(read_scene_string(head, "a.yaml").numerics.artificial_wall_normal.has_value());
+  EXPECT_EQ(read_scene_string(head + "numerics: {viscosity: {type: artificial, alpha: 0.02, walls: normal}}\n", "b.yaml")
+                .numerics.artificial_wall_normal,
+            std::optional<bool>(true));
+  EXPECT_EQ(read_scene_string(head + "numerics: {viscosity: {type: artificial, walls: pair}}\n", "c.yaml")
+                .numerics.artificial_wall_normal,
+            std::optional<bool>(false));
   const std::string laminar = error_of_string(head + "numerics: {viscosity: {type: laminar, walls: normal}}\n", "d.yaml");
   EXPECT_EQ(laminar.rfind("d.yaml:7:39: error: 'walls' applies only to 'artificial' viscosity", 0), 0u) << laminar;
 }

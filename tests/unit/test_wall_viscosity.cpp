@@ -4,7 +4,8 @@
 // wall neither approaches nor leaves it, so a viscosity that acts on approach exerts no force:
 // with `walls: normal` every fluid particle's acceleration is exactly zero with DBC walls (at rest
 // density, no pressure), and with mDBC within the float rounding of the extrapolated wall pressure
-// (2e-2 m/s^2, derived in tests/unit/test_free_slip.cpp; measured 5e-3). With the pair's approach v_ij . r_ij (`walls: pair`, the default) the wall
+// (2e-2 m/s^2, derived in tests/unit/test_free_slip.cpp; measured 5e-3). With the pair's approach
+// v_ij . r_ij (`walls: pair`, the default with DBC walls; mDBC's is `normal`) the wall
 // particles ahead of a fluid particle count as approached and those behind as left, and the
 // first row is pushed up off the floor and back: the artefact the option removes.
 #include <gtest/gtest.h>
@@ -13,6 +14,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include <optional>
 #include <random>
 
 #include "fsi/scene.hpp"
@@ -23,7 +25,7 @@ namespace {
 
 using namespace turbid;
 
-fsi::Scene sliding_water(bool wall_normal, fsi::BoundaryKind boundary) {
+fsi::Scene sliding_water(std::optional<bool> wall_normal, fsi::BoundaryKind boundary) {
   fsi::Scene s;
   s.name = "unit_wall_viscosity";
   s.dimensions = 2;
@@ -61,7 +63,7 @@ struct Row {
   double min_ay = 1e9, max_ax = -1e9;  // first row, away from the block's ends
 };
 
-Row measure(bool wall_normal, fsi::BoundaryKind boundary) {
+Row measure(std::optional<bool> wall_normal, fsi::BoundaryKind boundary) {
   fsi::Simulation sim(sliding_water(wall_normal, boundary), {"cpu", 1});
   sim.start();
   const auto& st = sim.store();
@@ -84,6 +86,19 @@ Row measure(bool wall_normal, fsi::BoundaryKind boundary) {
 TEST(WallViscosity, FlowAlongAWallFeelsNoArtificialViscosityWithTheNormalApproach) {
   EXPECT_EQ(measure(true, fsi::BoundaryKind::dbc).max_abs_a, 0.0) << "DBC";
   EXPECT_LT(measure(true, fsi::BoundaryKind::mdbc).max_abs_a, 2e-2) << "mDBC";
+}
+
+// Unset, the approach is the wall normal's with mDBC walls and the pair's with DBC (docs/choices.md,
+// "Artificial viscosity at walls"): the same sliding block reads as the stated option does, bit for bit.
+TEST(WallViscosity, TheDefaultIsTheNormalApproachWithMdbcAndThePairsWithDbc) {
+  for (auto boundary : {fsi::BoundaryKind::dbc, fsi::BoundaryKind::mdbc}) {
+    const bool normal = boundary == fsi::BoundaryKind::mdbc;
+    fsi::Simulation sim(sliding_water(std::nullopt, boundary), {"cpu", 1});
+    EXPECT_EQ(sim.params().wall_viscosity_normal, normal);
+    const Row unset = measure(std::nullopt, boundary), stated = measure(normal, boundary);
+    EXPECT_EQ(unset.max_abs_a, stated.max_abs_a);
+    EXPECT_EQ(unset.min_ay, stated.min_ay);
+  }
 }
 
 TEST(WallViscosity, ThePairApproachPushesTheSameFlowOffTheWallAndBack) {
