@@ -9,6 +9,7 @@
 // the system is symmetric; it starts from the current velocities.
 #pragma once
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 
 #include "sph/backend.hpp"
@@ -30,6 +31,20 @@ struct ViscousWork {
   Vec<D>* full_dR = nullptr;  // the full stress's dR/du, with the full-stress form only
   Mat<D>* fs[3] = {nullptr, nullptr, nullptr};  // renormalisation, gradient, Q (full stress only)
   Real* carrier = nullptr;                      // full stress only
+
+  // The arrays laid out in blocks of `stride` particles: `vectors` holds the eight vector arrays
+  // above in their order, `tensors` (null without the full stress) the three tensor arrays, and
+  // `carrier_mu` the carriers' viscosity.
+  static ViscousWork over(Vec<D>* vectors, Mat<D>* tensors, Real* carrier_mu, std::size_t stride) {
+    ViscousWork w;
+    Vec<D>** v[8] = {&w.x, &w.r, &w.z, &w.p, &w.q, &w.diag, &w.direct, &w.full_dR};
+    for (std::size_t k = 0; k < 8; ++k) *v[k] = vectors + k * stride;
+    if (tensors) {
+      for (std::size_t k = 0; k < 3; ++k) w.fs[k] = tensors + k * stride;
+      w.carrier = carrier_mu;
+    }
+    return w;
+  }
 };
 
 namespace cg {

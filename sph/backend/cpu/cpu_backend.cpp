@@ -174,27 +174,17 @@ class CpuBackend final : public Backend {
     const ParticleView<D> P = view<D>();
     const GridView<D> G = grid<D>();
     const std::uint32_t n = P.count;
-    std::vector<Vec<D>>* cg_ = cg_vectors<D>();
-    for (int k = 0; k < 8; ++k) cg_[k].resize(n);
-    ViscousWork<D> w;
-    w.x = cg_[0].data();
-    w.r = cg_[1].data();
-    w.z = cg_[2].data();
-    w.p = cg_[3].data();
-    w.q = cg_[4].data();
-    w.diag = cg_[5].data();
-    w.direct = cg_[6].data();
-    w.full_dR = cg_[7].data();
+    std::vector<Vec<D>>& cg = cg_vectors<D>();
+    cg.resize(8 * std::size_t(n));
+    Mat<D>* tensors = nullptr;
     if (params_.full_stress) {
       // The full-stress form (sph/full_stress.hpp): renormalisation, gradient and Q per particle.
-      std::vector<Mat<D>>* fs = full_stress_tensors<D>();
-      for (int k = 0; k < 3; ++k) {
-        fs[k].resize(n);
-        w.fs[k] = fs[k].data();
-      }
+      std::vector<Mat<D>>& fs = full_stress_tensors<D>();
+      fs.resize(3 * std::size_t(n));
+      tensors = fs.data();
       carrier_mu_.resize(n);
-      w.carrier = carrier_mu_.data();
     }
+    const ViscousWork<D> w = ViscousWork<D>::over(cg.data(), tensors, carrier_mu_.data(), n);
     const NeighbourList L = list(false);
     ViscousSolve out;
     Exec ex{this};
@@ -584,22 +574,22 @@ class CpuBackend final : public Backend {
   std::uint32_t list_stride_ = 0;
   bool list_valid_ = false;
   std::vector<Real> soa_;
-  // Implicit viscosity: the conjugate-gradient vectors (x, r, z, p, A p) per dimension, the
-  // diagonal, and the block sums of the fixed-order reductions.
-  // x, r, z, p, q, the diagonal of the implicit viscous CG, the full-stress pair part and acceleration
-  std::vector<Vec<2>> cg2_[8];
-  std::vector<Vec<3>> cg3_[8];
+  // Implicit viscosity: the solve's eight vector arrays in blocks of the particle count (x, r, z,
+  // p, A p, the diagonal, the full stress's direct part and dR/du: ViscousWork::over), per
+  // dimension; the full stress's three tensor arrays (renormalisation, gradient, Q) likewise.
+  std::vector<Vec<2>> cg2_;
+  std::vector<Vec<3>> cg3_;
   std::vector<Real> carrier_mu_;  // full stress: the carriers' viscosity (0: not a carrier)
-  std::vector<Mat<2>> fs2_[3];    // full stress: renormalisation, gradient, Q
-  std::vector<Mat<3>> fs3_[3];
+  std::vector<Mat<2>> fs2_;
+  std::vector<Mat<3>> fs3_;
   template <int D>
-  std::vector<Mat<D>>* full_stress_tensors() {
+  std::vector<Mat<D>>& full_stress_tensors() {
     if constexpr (D == 2) return fs2_;
     else return fs3_;
   }
-  std::vector<double> block_sums_;
+  std::vector<double> block_sums_;  // the fixed-order reductions' block sums
   template <int D>
-  std::vector<Vec<D>>* cg_vectors() {
+  std::vector<Vec<D>>& cg_vectors() {
     if constexpr (D == 2) return cg2_;
     else return cg3_;
   }

@@ -577,22 +577,14 @@ class DeviceBackend final : public Backend {
     // Work arrays for the whole capacity, from the first solve (scenes without it hold none).
     const std::size_t cap = capacity_;
     viscous_work_.ensure(8 * cap * sizeof(Vec<D>));
-    Vec<D>* cg = viscous_work_.as<Vec<D>>();
-    ViscousWork<D> w;
-    w.x = cg;
-    w.r = cg + cap;
-    w.z = cg + 2 * cap;
-    w.p = cg + 3 * cap;
-    w.q = cg + 4 * cap;
-    w.diag = cg + 5 * cap;
-    w.direct = cg + 6 * cap;
-    w.full_dR = cg + 7 * cap;
+    Mat<D>* fs = nullptr;
+    Real* carrier = nullptr;  // after the tensors, in the same buffer
     if (params_.full_stress) {
       full_stress_work_.ensure(3 * cap * sizeof(Mat<D>) + cap * sizeof(Real));
-      Mat<D>* fs = full_stress_work_.as<Mat<D>>();
-      for (int k = 0; k < 3; ++k) w.fs[k] = fs + std::size_t(k) * cap;
-      w.carrier = reinterpret_cast<Real*>(fs + 3 * cap);
+      fs = full_stress_work_.as<Mat<D>>();
+      carrier = reinterpret_cast<Real*>(fs + 3 * cap);
     }
+    const ViscousWork<D> w = ViscousWork<D>::over(viscous_work_.as<Vec<D>>(), fs, carrier, cap);
     ViscousSolve out;
     Exec<D> ex{this};
     dispatch_kernel<D>(params_, [&](auto kernel_tag, auto uniform_tag) {
