@@ -43,6 +43,9 @@ struct HealthIssue {
 struct StepCheck {
   std::optional<HealthIssue> issue;
   StepStats stats;
+  // Particles that left the domain at a neighbour update inside the step and were counted only
+  // now (Backend::update_neighbours_in_step); 0 on backends that count them at the update.
+  std::size_t removed = 0;
 };
 
 class Backend {
@@ -73,6 +76,15 @@ class Backend {
     if (!c.issue) c.stats = stats();
     return c;
   }
+  // The neighbour update inside a time step, between the drift and the force pass: as
+  // update_neighbours, but a backend may leave the count of the particles that left the domain to
+  // the step's check_step (StepCheck::removed) instead of waiting for it here; the device backend
+  // does, so that a step waits for the device once (issue #22). Returns the count it knows now.
+  virtual std::size_t update_neighbours_in_step() { return update_neighbours(); }
+  // Times the host has waited for the device since construction: a copy to or from device memory,
+  // a reduction's value, a compaction's count, an algorithm run with a blocking policy (0 where
+  // host and device are one). On the OpenMP device build it counts the calls that block on CUDA.
+  virtual std::uint64_t host_waits() const { return 0; }
   virtual void sync_to_host() = 0;    // make the store current (no-op on the CPU)
   virtual void sync_from_host() = 0;  // the store was edited on the host (resume)
   // After a resume's neighbour update: rebuild whatever the last force pass left for the next

@@ -80,7 +80,7 @@ void Solver::step(double dt) {
     inflow_ += c.inflow;
     outflow_ += c.outflow;
   }
-  removed_ += backend_->update_neighbours();
+  removed_ += backend_->update_neighbours_in_step();
   backend_->compute_forces();
   if (coupling_) coupling_->after_forces(*backend_);
   backend_->kick(0.5 * dt);
@@ -150,6 +150,7 @@ void Solver::lower_daughter_h(double h) {
 
 void Solver::check(const char* phase) {
   StepCheck c = backend_->check_step(time_params_.density_ratio_limit);
+  removed_ += c.removed;
   if (auto& issue = c.issue) {
     checked_stats_.reset();  // stats of a state that failed its check: not for the next step
     std::ostringstream os;

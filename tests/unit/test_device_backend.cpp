@@ -7,7 +7,10 @@
 //  - what a step copies between host and device does not grow with the particle count (issue #22:
 //    O(bodies + zones) bytes, not O(N)), measured with Backend::host_device_bytes at two spacings
 //    of a scene with open boundaries and of one with a free body;
-//  - steady steps allocate no temporary storage (the caching allocator).
+//  - steady steps allocate no temporary storage (the caching allocator);
+//  - a step of a water scene waits for the device once (issue #22: dt, health and the particle
+//    count from one reduction), counted with Backend::host_waits, and particles that leave the
+//    domain are still removed at the step they leave, as on the CPU.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -227,6 +230,7 @@ fsi::RunOptions on(const std::string& backend) {
 struct Traffic {
   std::size_t particles = 0;
   double bytes_per_step = 0;
+  double waits_per_step = 0;  // times the host waited for the device (Backend::host_waits)
   std::size_t allocations_after_warmup = 0, allocations_at_end = 0;
 };
 
@@ -241,25 +245,31 @@ Traffic traffic(fsi::Scene scene, const std::string& device, int steps) {
   for (int k = 0; k < 5; ++k) sim.step();
   Traffic t;
   t.particles = sim.store().size();
-  const std::uint64_t before = sim.backend().host_device_bytes();
+  const std::uint64_t before = sim.backend().host_device_bytes(), waits = sim.backend().host_waits();
   for (int k = 0; k < steps; ++k) sim.step();
   t.bytes_per_step = double(sim.backend().host_device_bytes() - before) / steps;
+  t.waits_per_step = double(sim.backend().host_waits() - waits) / steps;
   t.allocations_after_warmup = sim.backend().temporary_allocations();
   for (int k = 0; k < steps; ++k) sim.step();
   t.allocations_at_end = sim.backend().temporary_allocations();
   return t;
 }
 
-void expect_traffic_independent_of_n(const std::string& what, fsi::Scene coarse, fsi::Scene fine, const std::string& device) {
+// max_waits: the waits a step of the scene may have whatever N is (counted from the calls it makes).
+void expect_traffic_independent_of_n(const std::string& what, fsi::Scene coarse, fsi::Scene fine, const std::string& device,
+                                     double max_waits) {
   const Traffic a = traffic(coarse, device, 20), b = traffic(fine, device, 20);
-  std::printf("[ measured ] %s on %s: %zu particles %.1f bytes/step, %zu particles %.1f bytes/step; temporary blocks "
-              "%zu -> %zu and %zu -> %zu over the 20 steps after\n",
-              what.c_str(), device.c_str(), a.particles, a.bytes_per_step, b.particles, b.bytes_per_step,
-              a.allocations_after_warmup, a.allocations_at_end, b.allocations_after_warmup, b.allocations_at_end);
+  std::printf("[ measured ] %s on %s: %zu particles %.1f bytes/step (%.2f waits), %zu particles %.1f bytes/step "
+              "(%.2f waits); temporary blocks %zu -> %zu and %zu -> %zu over the 20 steps after\n",
+              what.c_str(), device.c_str(), a.particles, a.bytes_per_step, a.waits_per_step, b.particles,
+              b.bytes_per_step, b.waits_per_step, a.allocations_after_warmup, a.allocations_at_end,
+              b.allocations_after_warmup, b.allocations_at_end);
   ASSERT_GT(b.particles, 3 * a.particles);
   // O(bodies + zones): a few small reductions and the bodies' states, whatever N is.
   EXPECT_LE(b.bytes_per_step, 1024.0);
   EXPECT_LE(b.bytes_per_step, a.bytes_per_step + 64.0) << "grows with the particle count";
+  EXPECT_LE(a.waits_per_step, max_waits);
+  EXPECT_LE(b.waits_per_step, max_waits);
   // Steady steps reuse the cached blocks, also while inflow adds particles.
   EXPECT_EQ(a.allocations_at_end, a.allocations_after_warmup);
   EXPECT_EQ(b.allocations_at_end, b.allocations_after_warmup);
@@ -271,7 +281,8 @@ TEST(DeviceBackend, HostTrafficPerStepDoesNotGrowWithParticlesWithOpenBoundaries
     fsi::Scene coarse = tools::read_scene_file(path), fine = coarse;
     coarse.particle_spacing = 0.02;
     fine.particle_spacing = 0.01;
-    expect_traffic_independent_of_n("channel with inlet and outlet", coarse, fine, device);
+    // The step's check, the zone tally, and the compaction's count on steps where particles leave.
+    expect_traffic_independent_of_n("channel with inlet and outlet", coarse, fine, device, 3.0);
   });
 }
 
@@ -279,7 +290,9 @@ TEST(DeviceBackend, HostTrafficPerStepDoesNotGrowWithParticlesWithAFreeBody) {
   turbid::testing::for_each_device_backend([](const std::string& device) {
     fsi::Scene coarse = test::scene_of(test::push_scene("free", "dbc")), fine = coarse;
     fine.particle_spacing = coarse.particle_spacing / 2;
-    expect_traffic_independent_of_n("pushed free box", coarse, fine, device);
+    // The step's check; two uploads of the placements; the loads: the count left by the sort, the
+    // structure list's count, one reduction for the body.
+    expect_traffic_independent_of_n("pushed free box", coarse, fine, device, 7.0);
   });
 }
 
@@ -300,6 +313,84 @@ TEST(DeviceBackend, DeviceMemoryPerParticleIsWhatTurbidCheckSays) {
     std::printf("[ measured ] %s, 3D dam break, %zu particles: %.1f bytes/particle held, %zu planned (fields %zu, sort %zu)\n",
                 device.c_str(), sim.store().size(), held, plan.total(), plan.fields, plan.sort);
     EXPECT_NEAR(held, double(plan.total()), 0.15 * double(plan.total()));
+  });
+}
+
+// A step of a scene with walls and water and nothing else (the 2D dam break) waits for the device
+// once: the step's check (dt's speeds, the health check and the count of particles still in the
+// domain after the sort, in one reduction). Counted over 20 steps after 5 of warm-up. The CPU
+// backend, where host and device are one, waits never.
+TEST(DeviceBackend, AStepOfWaterWaitsForTheDeviceOnce) {
+  turbid::testing::for_each_device_backend([](const std::string& device) {
+    fsi::Scene scene = tools::read_scene_file(std::string(TURBID_SOURCE_DIR) + "/scenes/dam_break_2d.yaml");
+    scene.output.vtk = false;
+    scene.particle_spacing = 0.005;
+    fsi::Simulation sim(scene, on(device));
+    sim.start();
+    for (int k = 0; k < 5; ++k) sim.step();
+    const std::uint64_t before = sim.backend().host_waits();
+    constexpr int kSteps = 20;
+    for (int k = 0; k < kSteps; ++k) sim.step();
+    const double per_step = double(sim.backend().host_waits() - before) / kSteps;
+    std::printf("[ measured ] %s, dam break 2D, %zu particles: %.2f waits for the device per step\n", device.c_str(),
+                sim.store().size(), per_step);
+    EXPECT_EQ(per_step, 1.0);
+  });
+  fsi::Scene scene = tools::read_scene_file(std::string(TURBID_SOURCE_DIR) + "/scenes/dam_break_2d.yaml");
+  scene.output.vtk = false;
+  scene.particle_spacing = 0.005;
+  fsi::Simulation sim(scene, test::cpu());
+  sim.start();
+  for (int k = 0; k < 5; ++k) sim.step();
+  EXPECT_EQ(sim.backend().host_waits(), 0u);
+}
+
+// The count of particles in the domain waits for the step's check on the device backend; the
+// particles that left are still gone from that step on, as on the CPU: a block of water falls
+// freely out through the floor of a domain without walls (gravity 100 m/s^2). Reference: the CPU
+// backend, which removes them at the sort; the particle count and the removed count agree at every
+// step, and the last particle has gone at the same step.
+TEST(DeviceBackend, ParticlesLeavingTheDomainGoAtTheStepTheyLeaveAsOnTheCpu) {
+  const std::string yaml = R"(
+name: falling_out
+dimensions: 2
+resolution: {particle_spacing: 0.005, smoothing_ratio: 2.0}
+time: {end: 1.0, cfl: 0.2}
+gravity: [0, -100]
+numerics:
+  kernel: wendland_c2
+  density_diffusion: {type: fourtakas, delta: 0.1}
+  viscosity: {type: artificial, alpha: 0.02}
+materials:
+  water: {model: newtonian, density: 1000, viscosity: 1.0e-3, sound_speed: 20}
+domain: {min: [0, 0], max: [0.2, 0.2]}
+fluids:
+  - {material: water, box: {min: [0.05, 0.0], max: [0.15, 0.05]}}
+output: {every: 1.0, vtk: false}
+)";
+  turbid::testing::for_each_device_backend([&](const std::string& device) {
+    const fsi::Scene scene = tools::read_scene_string(yaml, "falling_out.yaml");
+    fsi::Simulation cpu(scene, test::cpu()), gpu(scene, on(device));
+    cpu.start();
+    gpu.start();
+    const std::size_t n0 = cpu.store().size();
+    ASSERT_EQ(gpu.store().size(), n0);
+    ASSERT_GT(n0, 100u);
+    int steps_with_removals = 0, last_step = -1;
+    for (int k = 0; k < 2000 && cpu.store().size() > 0; ++k) {
+      const std::size_t before = cpu.store().size();
+      cpu.step();
+      gpu.step();
+      ASSERT_EQ(gpu.store().size(), cpu.store().size()) << device << ", step " << k;
+      ASSERT_EQ(gpu.removed(), cpu.removed()) << device << ", step " << k;
+      ASSERT_EQ(cpu.removed(), n0 - cpu.store().size()) << "step " << k;
+      if (cpu.store().size() < before) ++steps_with_removals;
+      last_step = k;
+    }
+    std::printf("[ measured ] %s: %zu particles left the domain over %d steps (removals at %d of them)\n",
+                device.c_str(), n0, last_step + 1, steps_with_removals);
+    EXPECT_EQ(cpu.store().size(), 0u) << "the block fell out of the domain";
+    EXPECT_GT(steps_with_removals, 5) << "particles left over several steps, not all at once";
   });
 }
 

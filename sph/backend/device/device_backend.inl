@@ -30,6 +30,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sph/backend.hpp"
@@ -99,12 +100,13 @@ struct CellStartPass {
   }
 };
 
-// 1 for a fluid particle, 0 otherwise, and 0 past the last particle (the scan's total).
+// 1 for a fluid particle, 0 otherwise, and 0 past the last kept particle (the scan's total); the
+// kept count is read on the device (cell_start[cell_count]), so the host need not wait for it.
 struct FluidFlagPass {
   const std::uint8_t* kind;
-  std::uint32_t n;
+  const std::uint32_t* kept;
   std::uint32_t* flag;
-  TURBID_HD void operator()(std::uint32_t i) const { flag[i] = i < n && kind[i] == std::uint8_t(Kind::fluid) ? 1u : 0u; }
+  TURBID_HD void operator()(std::uint32_t i) const { flag[i] = i < *kept && kind[i] == std::uint8_t(Kind::fluid) ? 1u : 0u; }
 };
 
 // fluid_before[c] = fluid particles in cells [0, c): the scan of the flags at the cell's first
@@ -172,21 +174,30 @@ struct HealthPass {
   TURBID_HD std::uint32_t operator()(std::uint32_t i) const { return healthy(i) ? kHealthy : i; }
 };
 
-// The health check and the speeds in one reduction (Backend::check_step).
+// The health check, the speeds and the particle count in one reduction (Backend::check_step).
+// After a neighbour update inside the step the count is the sort's kept particles, read on the
+// device (`kept`, else all n): the particles past it left the domain and are not reported on.
 struct StepReport {
   SpeedPair speed;
-  std::uint32_t bad;  // the first unhealthy particle, kHealthy if none
+  std::uint32_t bad;   // the first unhealthy particle, kHealthy if none
+  std::uint32_t kept;  // particles in the domain
 };
 struct CombineStepReport {
   TURBID_HD StepReport operator()(const StepReport& a, const StepReport& b) const {
-    return {MaxSpeedPair{}(a.speed, b.speed), a.bad < b.bad ? a.bad : b.bad};
+    return {MaxSpeedPair{}(a.speed, b.speed), a.bad < b.bad ? a.bad : b.bad, a.kept < b.kept ? b.kept : a.kept};
   }
 };
 template <int D>
 struct StepReportPass {
   SpeedPass<D> speed;
   HealthPass<D> health;
-  TURBID_HD StepReport operator()(std::uint32_t i) const { return {speed(i), health(i)}; }
+  const std::uint32_t* kept;  // nullptr: all n are kept
+  std::uint32_t n;
+  TURBID_HD StepReport operator()(std::uint32_t i) const {
+    const std::uint32_t k = kept ? *kept : n;
+    if (i >= k) return {{0.f, 0.f}, kHealthy, k};
+    return {speed(i), health(i), k};
+  }
 };
 
 // Neighbours within the support 2h of each particle (itself excluded), as the CPU counts them.
@@ -377,11 +388,26 @@ class DeviceBackend final : public Backend {
     upload();
   }
 
+  // The sort leaves the count of particles still in the domain on the device (count_pending_):
+  // update_neighbours reads it at once, update_neighbours_in_step leaves it to the step's one
+  // reduction (check_step). Until then n_ is an upper bound: the particles past the kept ones left
+  // the domain, sit in no cell (no pair sees them) and the force pass and the kick, which write
+  // only each particle's own values, may run over them. Every other entry point settles first.
   std::size_t update_neighbours() override {
-    return params_.dimensions == 2 ? sort_by_cell<2>() : sort_by_cell<3>();
+    settle();
+    if (params_.dimensions == 2) sort_by_cell<2>();
+    else sort_by_cell<3>();
+    return settle_now();
+  }
+  std::size_t update_neighbours_in_step() override {
+    settle();
+    if (params_.dimensions == 2) sort_by_cell<2>();
+    else sort_by_cell<3>();
+    return 0;
   }
 
   void compute_density_rate() override {
+    settle();
     if (params_.dimensions == 2) compute_rate<2>();
     else compute_rate<3>();
   }
@@ -397,6 +423,7 @@ class DeviceBackend final : public Backend {
   }
 
   void drift(double dt) override {
+    settle();
     const Real wall_rho_min = params_.materials[params_.wall_material].eos.no_tension_density();
     if (params_.dimensions == 2) launch("DriftPass<2>", n_, DriftPass<2>{view<2>(), Real(dt), wall_rho_min, params_});
     else launch("DriftPass<3>", n_, DriftPass<3>{view<3>(), Real(dt), wall_rho_min, params_});
@@ -421,6 +448,7 @@ class DeviceBackend final : public Backend {
   // new particles do not fit; the host store follows the count, its data at sync_to_host().
   OpenBoundaryCounts update_open_boundaries() override {
     OpenBoundaryCounts c;
+    settle();
     if (params_.zone_count == 0 || n_ == 0) return c;
     const std::uint32_t n = n_;
     zone_crossing_.ensure(capacity_);
@@ -440,7 +468,7 @@ class DeviceBackend final : public Backend {
       if (std::size_t(n) + t.inflow > capacity_) grow(std::max<std::size_t>(2 * capacity_, std::size_t(n) + t.inflow));
       // spawn flags (keys_) -> slots: scanned in place.
       std::uint32_t* slot = keys_.as<std::uint32_t>();
-      thrust::exclusive_scan(policy(cache_), slot, slot + n, slot);
+      thrust::exclusive_scan(async_policy(cache_), slot, slot + n, slot);
       const int on_device = std::min(store_->field_count(), int(fields_.size()));
       const SplitFieldTable table = split_field_table(*store_, on_device, [&](FieldId f) { return field(f); });
       launch("ZoneSpawnPass", n,
@@ -450,7 +478,7 @@ class DeviceBackend final : public Backend {
                            t.max_id + 1});
       total = n + t.inflow;
       // The new particles are kept.
-      thrust::fill(policy(cache_), order_.as<std::uint32_t>() + n, order_.as<std::uint32_t>() + total, 1u);
+      thrust::fill(async_policy(cache_), order_.as<std::uint32_t>() + n, order_.as<std::uint32_t>() + total, 1u);
     }
     if (t.outflow > 0) {
       // keep flags (order_) -> the kept particles' indices, in order (keys_), then every field gathered.
@@ -459,6 +487,7 @@ class DeviceBackend final : public Backend {
       std::uint32_t* end = thrust::copy_if(policy(cache_), thrust::counting_iterator<std::uint32_t>(0),
                                            thrust::counting_iterator<std::uint32_t>(total), keep, kept_index,
                                            NonZero{});
+      ++waits_;  // the count comes back
       const std::uint32_t kept = std::uint32_t(end - kept_index);
       for (int f = 0; f < int(fields_.size()); ++f) gather_field(f, kept_index, kept);
       total = kept;
@@ -468,9 +497,13 @@ class DeviceBackend final : public Backend {
     return c;
   }
 
-  StepStats stats() override { return params_.dimensions == 2 ? stats_impl<2>() : stats_impl<3>(); }
+  StepStats stats() override {
+    settle();
+    return params_.dimensions == 2 ? stats_impl<2>() : stats_impl<3>();
+  }
 
   std::optional<HealthIssue> check_health(double limit) override {
+    settle();
     return params_.dimensions == 2 ? health_impl<2>(limit) : health_impl<3>(limit);
   }
 
@@ -480,6 +513,7 @@ class DeviceBackend final : public Backend {
 
   void sync_to_host() override {
     if (store_ == nullptr) return;
+    settle();
     store_->resize(n_);
     // A field registered on the host after bind() lives on the host until sync_from_host().
     const int on_device = std::min(store_->field_count(), int(fields_.size()));
@@ -498,6 +532,7 @@ class DeviceBackend final : public Backend {
   }
 
   std::uint64_t host_device_bytes() const override { return moved_; }
+  std::uint64_t host_waits() const override { return waits_; }
   std::size_t temporary_allocations() const override { return cache_.allocations(); }
   std::size_t device_bytes() const override {
     std::size_t b = cache_.bytes();
@@ -509,11 +544,14 @@ class DeviceBackend final : public Backend {
     return b;
   }
 
-  std::size_t pair_count() override { return params_.dimensions == 2 ? count_pairs<2>() : count_pairs<3>(); }
+  std::size_t pair_count() override {
+    settle();
+    return params_.dimensions == 2 ? count_pairs<2>() : count_pairs<3>(); }
 
   // The per-particle forces are summed on the host (few structure particles; double precision).
   std::vector<BodyLoad> body_loads(const std::vector<std::array<double, 3>>& reference) override {
     if (params_.body_count == 0 || ids_.structure_force < 0) return std::vector<BodyLoad>(reference.size());
+    settle();
     if (params_.dimensions == 2) return loads_impl<2>(reference);
     return loads_impl<3>(reference);
   }
@@ -523,6 +561,7 @@ class DeviceBackend final : public Backend {
   bool supports_moving_bodies() const override { return true; }
   void place_bodies(const std::vector<BodyPlacement>& bodies, bool move) override {
     if (ids_.body_offset < 0) throw std::logic_error("place_bodies: the store has no body_offset field");
+    settle();
     if (bodies.empty() || n_ == 0) return;
     placements_.ensure(bodies.size() * sizeof(BodyPlacement));
     to_device(placements_.get(), bodies.data(), bodies.size() * sizeof(BodyPlacement));
@@ -553,6 +592,7 @@ class DeviceBackend final : public Backend {
   // launched here, its dot products Thrust reductions in double (one value back each).
   bool supports_implicit_viscosity() const override { return true; }
   ViscousSolve solve_viscosity(double dt, double share, bool first_half) override {
+    settle();
     return params_.dimensions == 2 ? viscosity_impl<2>(Real(dt), Real(share), first_half)
                                    : viscosity_impl<3>(Real(dt), Real(share), first_half);
   }
@@ -597,9 +637,11 @@ class DeviceBackend final : public Backend {
 
   bool supports_splitting() const override { return true; }
   SplitCounts split(const SplitParams& rules) override {
+    settle();
     return params_.dimensions == 2 ? split_impl<2>(rules) : split_impl<3>(rules);
   }
   std::size_t relax_split(const SplitParams& rules) override {
+    settle();
     return params_.dimensions == 2 ? relax_impl<2>(rules) : relax_impl<3>(rules);
   }
 
@@ -617,6 +659,7 @@ class DeviceBackend final : public Backend {
     std::uint32_t* end = thrust::copy_if(policy(cache_), thrust::counting_iterator<std::uint32_t>(0),
                                          thrust::counting_iterator<std::uint32_t>(n_), list,
                                          OnBodyPred{body, int(reference.size())});
+    ++waits_;  // the count comes back
     const std::uint32_t count = std::uint32_t(end - list);
     moved_ += sizeof(std::uint32_t);  // the count
     for (std::size_t b = 0; b < reference.size(); ++b) {
@@ -680,6 +723,7 @@ class DeviceBackend final : public Backend {
   void upload() {
     const ParticleStore& s = *store_;
     n_ = std::uint32_t(s.size());
+    count_pending_ = false;
     for (int f = 0; f < s.field_count(); ++f) {
       const std::size_t bytes = std::size_t(n_) * s.field_bytes(f);
       to_device(fields_[std::size_t(f)].get(), s.raw(f), bytes);
@@ -687,14 +731,34 @@ class DeviceBackend final : public Backend {
   }
 
   // Copies between the host and the device, counted (bytes_moved()).
+  // Both block the host (cudaMemcpy from or to pageable memory).
   void to_device(void* dst, const void* src, std::size_t bytes) {
     copy_to_device(dst, src, bytes);
     moved_ += bytes;
+    ++waits_;
   }
   void to_host(void* dst, const void* src, std::size_t bytes) {
     copy_to_host(dst, src, bytes);
     moved_ += bytes;
+    ++waits_;
   }
+  // The kept count of the last sort, if it is still on the device: read it (one wait) and make it
+  // the particle count. Returns the particles the sort removed.
+  std::size_t settle_now() {
+    if (!count_pending_) return 0;
+    return take_count(read_one(cell_start_.as<std::uint32_t>() + cell_count_));
+  }
+  std::size_t take_count(std::uint32_t kept) {
+    count_pending_ = false;
+    const std::size_t removed = n_ - kept;
+    n_ = kept;
+    // Keep the host's count in step (shrinking only moves the size); the data follow at sync_to_host().
+    if (store_->size() > kept) store_->resize(kept);
+    return removed;
+  }
+  // As settle_now, for entry points that need the exact count: the removed particles are reported
+  // at the next check_step.
+  void settle() { unreported_removed_ += settle_now(); }
   // One value of type T at p on the device.
   template <class T>
   T read_one(const T* p) {
@@ -709,6 +773,7 @@ class DeviceBackend final : public Backend {
     const T v = thrust::transform_reduce(policy(cache_), thrust::counting_iterator<std::uint32_t>(0),
                                          thrust::counting_iterator<std::uint32_t>(n), f, init, op);
     moved_ += sizeof(T);
+    ++waits_;
     return v;
   }
 
@@ -764,8 +829,10 @@ class DeviceBackend final : public Backend {
     else copy_on_device(buf.get(), scratch_.get(), total);
   }
 
+  // Sorts by cell key; the particles outside the domain go last, past cell_start[cell_count] (the
+  // kept count, left on the device: count_pending_).
   template <int D>
-  std::size_t sort_by_cell() {
+  void sort_by_cell() {
     const std::uint32_t n = n_;
     const GridView<D> g = grid<D>();
     std::uint32_t* keys = keys_.as<std::uint32_t>();
@@ -776,24 +843,21 @@ class DeviceBackend final : public Backend {
     launch("KeysPass", n, key_pass);
     if (n > 0) {
       // A stable sort: inside a cell particles keep their order, as in the CPU counting sort.
-      thrust::stable_sort_by_key(policy(cache_), keys, keys + n, order);
+      thrust::stable_sort_by_key(async_policy(cache_), keys, keys + n, order);
       for (int f = 0; f < int(fields_.size()); ++f)
         if (store_->desc(f).follows_sort) gather_field(f, order, n);
     }
+    const std::uint32_t* kept = cell_start_.as<std::uint32_t>() + cell_count_;
     launch("CellStartPass", std::uint32_t(cell_count_ + 1), CellStartPass{keys, n, cell_start_.as<std::uint32_t>()});
-    const std::uint32_t kept = read_one(cell_start_.as<std::uint32_t>() + cell_count_);
-    n_ = kept;
+    count_pending_ = true;
     // fluid_before, so that wall particles with no fluid in their 3^d cells skip the search (the
-    // CPU's shortcut, same results): flags of the kept particles (and a 0 after them), scanned.
+    // CPU's shortcut, same results): flags of the kept particles (0 after them and at n), scanned.
     const std::uint8_t* kind = fields_[std::size_t(ids_.kind)].as<std::uint8_t>();
     std::uint32_t* flags = order;  // the order is spent once the fields are gathered
-    launch("FluidFlagPass", kept + 1, FluidFlagPass{kind, kept, flags});
-    thrust::exclusive_scan(policy(cache_), flags, flags + kept + 1, keys);
+    launch("FluidFlagPass", n + 1, FluidFlagPass{kind, kept, flags});
+    thrust::exclusive_scan(async_policy(cache_), flags, flags + n + 1, keys);
     launch("FluidBeforePass", std::uint32_t(cell_count_ + 1),
            FluidBeforePass{cell_start_.as<std::uint32_t>(), keys, fluid_before_.as<std::uint32_t>()});
-    // Keep the host's count in step (shrinking only moves the size); the data follow at sync_to_host().
-    if (store_->size() > kept) store_->resize(kept);
-    return n - kept;
   }
 
   template <int D>
@@ -857,7 +921,7 @@ class DeviceBackend final : public Backend {
     });
     // Accumulated in 64 bits (the initial value's and the operator's type), like the CPU's
     // std::exclusive_scan.
-    thrust::exclusive_scan(policy(cache_), slots, slots + n, first, std::uint64_t(0), thrust::plus<std::uint64_t>());
+    thrust::exclusive_scan(async_policy(cache_), slots, slots + n, first, std::uint64_t(0), thrust::plus<std::uint64_t>());
     // The store's capacity, as on the CPU (the device buffers hold at least as much).
     const std::uint64_t capacity = std::min<std::uint64_t>(capacity_, store_->capacity());
     const std::uint64_t room = capacity > n ? capacity - n : 0;
@@ -928,13 +992,23 @@ class DeviceBackend final : public Backend {
     return describe_unhealthy<D>(i);
   }
 
+  // One reduction, the step's one wait for the device: health, speeds and, after a neighbour update
+  // inside the step, the count of particles still in the domain.
   template <int D>
   StepCheck check_step_impl(double limit) {
     StepCheck c;
-    if (n_ == 0) return c;
+    if (n_ == 0) {
+      count_pending_ = false;
+      c.removed = std::exchange(unreported_removed_, 0);
+      return c;
+    }
     const ParticleView<D> P = view<D>();
-    const StepReport r = reduce(n_, StepReportPass<D>{SpeedPass<D>{P}, HealthPass<D>::make(P, params_, limit)},
-                                StepReport{{0.f, 0.f}, kHealthy}, CombineStepReport{});
+    const std::uint32_t* kept = count_pending_ ? cell_start_.as<std::uint32_t>() + cell_count_ : nullptr;
+    const StepReport r =
+        reduce(n_, StepReportPass<D>{SpeedPass<D>{P}, HealthPass<D>::make(P, params_, limit), kept, n_},
+               StepReport{{0.f, 0.f}, kHealthy, 0u}, CombineStepReport{});
+    if (count_pending_) unreported_removed_ += take_count(r.kept);
+    c.removed = std::exchange(unreported_removed_, 0);
     if (r.bad != kHealthy) c.issue = describe_unhealthy<D>(r.bad);
     else c.stats = {std::sqrt(double(r.speed.v2)), std::sqrt(double(r.speed.a2))};
     return c;
@@ -976,7 +1050,9 @@ class DeviceBackend final : public Backend {
   GridLayout layout_;
   double domain_max_[3] = {0, 0, 0};
   std::size_t cell_count_ = 1;
-  std::uint32_t n_ = 0;       // particles on the device
+  std::uint32_t n_ = 0;       // particles on the device (an upper bound while count_pending_)
+  bool count_pending_ = false;          // the last sort's kept count is on the device only
+  std::size_t unreported_removed_ = 0;  // removed by sorts, not yet reported (check_step)
   std::size_t capacity_ = 0;  // particles the device buffers hold
   std::vector<DeviceBuffer> fields_;  // indexed by FieldId
   DeviceBuffer scratch_;              // gather target, capacity x widest field
@@ -991,6 +1067,7 @@ class DeviceBackend final : public Backend {
   DeviceBuffer viscous_work_, full_stress_work_;  // implicit viscosity: the solve's arrays, from the first solve
   CachingAllocator cache_;   // Thrust's temporary storage
   std::uint64_t moved_ = 0;  // bytes copied between host and device since construction
+  std::uint64_t waits_ = 0;  // times the host waited for the device since construction (host_waits)
 };
 
 }  // namespace

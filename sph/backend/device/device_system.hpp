@@ -151,10 +151,21 @@ class CachingAllocator {
   std::size_t allocations_ = 0;
 };
 
-// The execution policy for Thrust's algorithms, with the caching allocator.
+// The execution policies for Thrust's algorithms, with the caching allocator. `policy` blocks until
+// the device is done (Thrust's CUDA par synchronises after each algorithm): for the algorithms whose
+// result the host reads (a compaction's count). `async_policy` returns at once on CUDA (par_nosync):
+// for sorts, scans and fills whose results only later device work reads, in stream order. On the
+// OpenMP system both are the same synchronous policy.
 inline auto policy(CachingAllocator& a) {
 #if TURBID_DEVICE_CUDA
   return thrust::cuda::par(a);
+#else
+  return thrust::omp::par(a);
+#endif
+}
+inline auto async_policy(CachingAllocator& a) {
+#if TURBID_DEVICE_CUDA
+  return thrust::cuda::par_nosync(a);
 #else
   return thrust::omp::par(a);
 #endif
