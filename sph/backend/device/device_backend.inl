@@ -394,15 +394,11 @@ class DeviceBackend final : public Backend {
   // the domain, sit in no cell (no pair sees them) and the force pass and the kick, which write
   // only each particle's own values, may run over them. Every other entry point settles first.
   std::size_t update_neighbours() override {
-    settle();
-    if (params_.dimensions == 2) sort_by_cell<2>();
-    else sort_by_cell<3>();
+    sort();
     return settle_now();
   }
   std::size_t update_neighbours_in_step() override {
-    settle();
-    if (params_.dimensions == 2) sort_by_cell<2>();
-    else sort_by_cell<3>();
+    sort();
     return 0;
   }
 
@@ -546,7 +542,8 @@ class DeviceBackend final : public Backend {
 
   std::size_t pair_count() override {
     settle();
-    return params_.dimensions == 2 ? count_pairs<2>() : count_pairs<3>(); }
+    return params_.dimensions == 2 ? count_pairs<2>() : count_pairs<3>();
+  }
 
   // The per-particle forces are summed on the host (few structure particles; double precision).
   std::vector<BodyLoad> body_loads(const std::vector<std::array<double, 3>>& reference) override {
@@ -746,7 +743,7 @@ class DeviceBackend final : public Backend {
   // the particle count. Returns the particles the sort removed.
   std::size_t settle_now() {
     if (!count_pending_) return 0;
-    return take_count(read_one(cell_start_.as<std::uint32_t>() + cell_count_));
+    return take_count(read_one(kept_on_device()));
   }
   std::size_t take_count(std::uint32_t kept) {
     count_pending_ = false;
@@ -759,6 +756,8 @@ class DeviceBackend final : public Backend {
   // As settle_now, for entry points that need the exact count: the removed particles are reported
   // at the next check_step.
   void settle() { unreported_removed_ += settle_now(); }
+  // Where the sort leaves its kept count: cell_start[cell_count], the keys below "outside".
+  const std::uint32_t* kept_on_device() const { return cell_start_.as<std::uint32_t>() + cell_count_; }
   // One value of type T at p on the device.
   template <class T>
   T read_one(const T* p) {
@@ -829,6 +828,13 @@ class DeviceBackend final : public Backend {
     else copy_on_device(buf.get(), scratch_.get(), total);
   }
 
+  // A neighbour update after the last one's count is settled; its own count stays on the device.
+  void sort() {
+    settle();
+    if (params_.dimensions == 2) sort_by_cell<2>();
+    else sort_by_cell<3>();
+  }
+
   // Sorts by cell key; the particles outside the domain go last, past cell_start[cell_count] (the
   // kept count, left on the device: count_pending_).
   template <int D>
@@ -847,14 +853,13 @@ class DeviceBackend final : public Backend {
       for (int f = 0; f < int(fields_.size()); ++f)
         if (store_->desc(f).follows_sort) gather_field(f, order, n);
     }
-    const std::uint32_t* kept = cell_start_.as<std::uint32_t>() + cell_count_;
     launch("CellStartPass", std::uint32_t(cell_count_ + 1), CellStartPass{keys, n, cell_start_.as<std::uint32_t>()});
     count_pending_ = true;
     // fluid_before, so that wall particles with no fluid in their 3^d cells skip the search (the
     // CPU's shortcut, same results): flags of the kept particles (0 after them and at n), scanned.
     const std::uint8_t* kind = fields_[std::size_t(ids_.kind)].as<std::uint8_t>();
     std::uint32_t* flags = order;  // the order is spent once the fields are gathered
-    launch("FluidFlagPass", n + 1, FluidFlagPass{kind, kept, flags});
+    launch("FluidFlagPass", n + 1, FluidFlagPass{kind, kept_on_device(), flags});
     thrust::exclusive_scan(async_policy(cache_), flags, flags + n + 1, keys);
     launch("FluidBeforePass", std::uint32_t(cell_count_ + 1),
            FluidBeforePass{cell_start_.as<std::uint32_t>(), keys, fluid_before_.as<std::uint32_t>()});
@@ -1003,7 +1008,7 @@ class DeviceBackend final : public Backend {
       return c;
     }
     const ParticleView<D> P = view<D>();
-    const std::uint32_t* kept = count_pending_ ? cell_start_.as<std::uint32_t>() + cell_count_ : nullptr;
+    const std::uint32_t* kept = count_pending_ ? kept_on_device() : nullptr;
     const StepReport r =
         reduce(n_, StepReportPass<D>{SpeedPass<D>{P}, HealthPass<D>::make(P, params_, limit), kept, n_},
                StepReport{{0.f, 0.f}, kHealthy, 0u}, CombineStepReport{});
