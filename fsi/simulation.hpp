@@ -148,6 +148,12 @@ class Simulation {
   // run (a particle counts once per drift); 0 with `impermeable: false`.
   std::uint64_t wall_put_backs() { return wall_put_backs_before_ + solver_->backend().wall_put_backs(); }
   void restore_wall_put_backs(std::uint64_t n) { wall_put_backs_before_ = n; }
+  // What those put-backs took from the fluid over the whole run: the momentum the walls and
+  // structures received (booked on them, in forces.csv and bodies' loads) and the kinetic energy.
+  sph::WallConstraintTotals wall_constraint_totals() { return solver_->backend().wall_constraint_totals(); }
+  void restore_wall_constraint_totals(const sph::WallConstraintTotals& t) {
+    solver_->backend().restore_wall_constraint_totals(t);
+  }
 
   // Output bookkeeping, saved in checkpoints so a resumed run writes the same frames.
   std::uint64_t output_index() const { return output_index_; }

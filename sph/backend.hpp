@@ -32,6 +32,14 @@ struct ViscousSolve {
   double residual = 0;  // final relative residual |b - A x|_m / |b|_m
 };
 
+// What the impermeable-wall pass did to the fluid since the backend was bound (WallConstraintPass,
+// booked by WallConstraintLoadPass): the momentum it took from the fluid, which walls and
+// structures received [N s, 2D: N s/m], and the kinetic energy it removed [J, 2D: J/m].
+struct WallConstraintTotals {
+  double impulse[3] = {0, 0, 0};
+  double energy = 0;
+};
+
 struct HealthIssue {
   std::size_t index = 0;  // position in the store
   std::uint32_t id = 0;   // particle id (stable across sorts)
@@ -64,6 +72,10 @@ class Backend {
   // Fluid particles the drift put back on a wall's surface since bind (impermeable walls; one per
   // particle and drift), a diagnostic of how much the walls' pressure alone would have let through.
   virtual std::uint64_t wall_put_backs() { return 0; }
+  virtual WallConstraintTotals wall_constraint_totals() { return {}; }
+  // A resumed run goes on adding to the checkpoint's totals (the same additions in the same order
+  // as the run it continues: the same bits).
+  virtual void restore_wall_constraint_totals(const WallConstraintTotals&) {}
   // After the drift, with open boundaries: particles crossing buffer-zone planes (open_boundary.hpp).
   virtual OpenBoundaryCounts update_open_boundaries() = 0;
   virtual StepStats stats() = 0;

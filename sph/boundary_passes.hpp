@@ -318,6 +318,8 @@ struct StructureForcePass {
     }
     // The implicit viscous updates' load on b for this step (sph/implicit_viscosity.hpp).
     if (P.viscous_load) f += P.viscous_load[b];
+    // The impulse of the last drift's put-backs off b (WallConstraintLoadPass).
+    if (P.constraint_force) f += P.constraint_force[b];
     P.structure_force[b] = f;
   }
 };
@@ -337,6 +339,12 @@ struct StructureForcePass {
 // relative to e's, removed (an inelastic stop; the tangential velocity is kept). Fluid in front of
 // the walls is untouched, so the pass changes nothing in flows that keep out of walls on their own.
 // The neighbours are those of the step's start: walls move less than a spacing per step.
+// The momentum the stop takes from i, m_i (v_after - v_before) over all its pushes, is kept in
+// put_back_impulse with the boundary particle it goes to (put_back_from: the one whose push took
+// the most normal speed, or the first pushed off when none took any), for WallConstraintLoadPass to
+// book on walls and structures: the fluid loses no momentum that they do not receive.
+inline constexpr std::uint32_t kNoPutBack = 0xffffffffu;
+
 template <int D>
 struct WallConstraintPass {
   ParticleView<D> P;
@@ -362,6 +370,7 @@ struct WallConstraintPass {
 
   TURBID_HD void operator()(std::uint32_t i) const {
     if (P.kind[i] != std::uint8_t(Kind::fluid)) return;
+    if (P.put_back_from) P.put_back_from[i] = kNoPutBack;
     int c[D] = {};
     if (G.cell_of(P.position[i], c) && !G.boundary_near(c)) return;  // most fluid: no wall within a cell
     // Pushes in turn: in a concave corner (the floor meeting an end wall) a particle behind both
@@ -370,15 +379,28 @@ struct WallConstraintPass {
     // diagonal ghost offsets, a surface across the corner, which takes a push of its own: 2 D
     // rounds bring a particle out of a corner of D faces (tested in 2D; 0 left in the 3D box case,
     // docs/validation.md W).
+    const Vec<D> v_before = P.velocity[i];
+    std::uint32_t from = kNoPutBack;
+    Real largest = Real(-1);
     for (int round = 0; round < 2 * D; ++round) {
-      if (!push_out(i)) return;
+      std::uint32_t j = 0;
+      Real taken = 0;
+      if (!push_out(i, j, taken)) break;
       if (round == 0 && put_back) count_one(put_back);
+      if (taken > largest) {
+        largest = taken;
+        from = j;
+      }
     }
+    if (from == kNoPutBack || !P.put_back_from) return;
+    P.put_back_from[i] = from;
+    P.put_back_impulse[i] = P.mass[i] * (P.velocity[i] - v_before);
   }
 
   // Puts i on the surface it is least behind unless it is in front of every surface near it or
-  // outside a convex edge; true when it moved.
-  TURBID_HD bool push_out(std::uint32_t i) const {
+  // outside a convex edge; true when it moved. `from`: the boundary particle of that surface;
+  // `taken`: the normal speed into it removed (0 when i was moving away from it).
+  TURBID_HD bool push_out(std::uint32_t i, std::uint32_t& from, Real& taken) const {
     const Vec<D> xi = P.position[i];
     // The nearest boundary particle, and whether i is behind any surface near it at all (most
     // fluid beside a wall is in front of every one: one loop then).
@@ -441,8 +463,53 @@ struct WallConstraintPass {
     P.position[i] = xi - exit_s * exit_n;
     const Real vn = dot(P.velocity[i] - P.velocity[exit_j], exit_n);
     if (vn < Real(0)) P.velocity[i] -= vn * exit_n;
+    from = exit_j;
+    taken = vn < Real(0) ? -vn : Real(0);
     return true;
   }
+};
+
+// The constraint's reaction (issue #47 item 1): each wall and structure particle b receives minus
+// the momentum put-backs took from the fluid particles booked to it (WallConstraintPass), as a
+// force over the step, and the kinetic energy they removed, as a power. A gather over b's fluid
+// neighbours, before the sort (put_back_from holds indices of this order): each fluid particle is
+// booked to exactly one b, so the fluid and the boundary exchange the same momentum to rounding,
+// without atomics, in the same order on every backend. The particle put back lies within 1.6 dx of
+// the surface particle it was pushed off, well inside the support 2h where b looks for it.
+// Kinetic energy removed from i: with J = m (v_after - v_before),
+//   1/2 m |v_before|^2 - 1/2 m |v_after|^2 = |J|^2 / (2 m) - v_after . J.
+// `counts`: [0] put-backs since bind, [1] the same before this drift; on a drift without any
+// (most of them) b only writes zeros.
+template <int D>
+struct WallConstraintLoadPass {
+  ParticleView<D> P;
+  GridView<D> G;
+  PhysicsParams prm;
+  Real inv_dt;
+  const unsigned long long* counts;
+
+  TURBID_HD void operator()(std::uint32_t b) const {
+    if (!WallConstraintPass<D>::boundary(P.kind[b])) return;
+    Vec<D> f = Vec<D>::zero();
+    Real power = 0;
+    int c[D] = {};
+    if (counts[0] != counts[1] && G.cell_of(P.position[b], c) && G.fluid_near(c)) {
+      for_each_neighbour<D>(P, G, NeighbourList{}, prm, b, P.position[b], [&](std::uint32_t i, const Vec<D>&, Real) {
+        if (P.kind[i] != std::uint8_t(Kind::fluid) || P.put_back_from[i] != b) return;
+        const Vec<D> J = P.put_back_impulse[i];
+        f -= J;
+        power += norm2(J) / (Real(2) * P.mass[i]) - dot(P.velocity[i], J);
+      });
+    }
+    P.constraint_force[b] = inv_dt * f;
+    P.constraint_power[b] = inv_dt * power;
+  }
+};
+
+// counts[1] = counts[0]: the put-backs before a drift (one thread).
+struct MarkPutBacksPass {
+  unsigned long long* counts;
+  TURBID_HD void operator()(std::uint32_t) const { counts[1] = counts[0]; }
 };
 
 }  // namespace turbid::sph

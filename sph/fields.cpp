@@ -67,6 +67,21 @@ FieldIds register_fields(ParticleStore& s, const PhysicsParams& p, bool structur
     f.viscous_pending =
         s.add_field({"viscous_pending", force_unit, ScalarType::f32, d, false, true, true, Carry::recompute});
   }
+  if (p.wall_constraint) {
+    const char* momentum_unit = d == 2 ? "N s/m" : "N s";
+    const char* force_unit = d == 2 ? "N/m" : "N";
+    const char* power_unit = d == 2 ? "W/m" : "W";
+    // Written for every fluid particle by each drift's WallConstraintPass and read by the booking
+    // right after it, before the sort: scratch, not sorted.
+    f.put_back_impulse =
+        s.add_field({"put_back_impulse", momentum_unit, ScalarType::f32, d, false, false, false, Carry::recompute});
+    f.put_back_from = s.add_field({"put_back_from", "", ScalarType::u32, 1, false, false, false, Carry::recompute});
+    // Booked on walls and structures after the drift, read by the force pass after the sort.
+    f.constraint_force =
+        s.add_field({"constraint_force", force_unit, ScalarType::f32, d, false, false, true, Carry::recompute});
+    f.constraint_power =
+        s.add_field({"constraint_power", power_unit, ScalarType::f32, 1, false, false, true, Carry::recompute});
+  }
   if (p.zone_count > 0) f.zone = s.add_field({"zone", "", ScalarType::u8, 1, true, true, true, Carry::copy});
   // Set by a split for its daughters and cleared by the next one; between steps it is read only by
   // the relaxation right after the split, so it is neither written out nor checkpointed.

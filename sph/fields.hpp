@@ -25,6 +25,12 @@ struct FieldIds {
   // Only with structures and implicit viscosity: the implicit viscous updates' reaction on each
   // structure particle, summed until the next force pass reads and clears it.
   FieldId viscous_load = -1, viscous_pending = -1;
+  // Only with impermeable walls (sph::WallConstraintPass): each fluid particle's momentum change
+  // by the put-back of the last drift and the boundary particle it is booked to (scratch between
+  // the pass and the booking, both before the sort), and each boundary particle's share of that
+  // drift's constraint, as a force and a power over the step (WallConstraintLoadPass).
+  FieldId put_back_impulse = -1, put_back_from = -1;
+  FieldId constraint_force = -1, constraint_power = -1;
 };
 
 // Registers what `params` needs (a water-only run with Fourtakas diffusion gets no gradient field).

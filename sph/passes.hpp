@@ -45,6 +45,11 @@ struct ParticleView {
   std::uint8_t* split_fresh = nullptr; // only with transitions: 1 for the daughters of the last split
   Vec<D>* viscous_load = nullptr;     // only with structures and implicit viscosity: see implicit_viscosity.hpp
   Vec<D>* viscous_pending = nullptr;
+  // Only with impermeable walls: see WallConstraintPass and WallConstraintLoadPass.
+  Vec<D>* put_back_impulse = nullptr;      // fluid: m (v after - v before) of the last drift's put-back [N s]
+  std::uint32_t* put_back_from = nullptr;  // fluid: the boundary particle it is booked to (kNoPutBack: none)
+  Vec<D>* constraint_force = nullptr;      // walls, structures: the put-backs booked to them / dt [N]
+  Real* constraint_power = nullptr;        // walls, structures: kinetic energy those put-backs removed / dt [W]
   // CPU only: positions as one array per coordinate (component a at a * soa_stride), a copy made
   // at each sort so that distance checks vectorise; valid until the next drift.
   const Real* position_soa = nullptr;
@@ -608,6 +613,17 @@ TURBID_HD inline Real wall_normal_approach(const Vec<D>& vij, const Vec<D>& rij,
   return n2 > Real(0) ? dot(vij, nj) * dot(rij, nj) / n2 : dot(vij, rij);
 }
 
+// The direction that artificial viscosity of such a wall pair acts along: r_ij's part along n_j,
+// (r_ij . n_j) n_j / |n_j|^2 (r_ij where j has no normal). With the approach above the pair's
+// power a_i . v_ij = s (v_ij . n_j)(r_ij . n_j) / |n_j|^2 = s x approach is never positive (s > 0
+// only for approach < 0): the pair dissipates. Along r_ij instead, on a curved wall the particles
+// behind one sliding past push it forward and outward (issue #47 item 3).
+template <int D>
+TURBID_HD inline Vec<D> wall_normal_direction(const Vec<D>& rij, const Vec<D>& nj) {
+  const Real n2 = norm2(nj);
+  return n2 > Real(0) ? (dot(rij, nj) / n2) * nj : rij;
+}
+
 // Wall shear of boundary particle j on fluid particle i (PhysicsParams::wall_function):
 //   a_i = -2 u*^2 t V_j max(0, -F r_ij . n_j),
 // t the direction of i's velocity relative to j along j's wall surface (normal n_j, from
@@ -662,12 +678,15 @@ TURBID_HD inline Vec<D> momentum_pair(const ParticleView<D>& P, const PhysicsPar
   // The wall function carries the whole wall shear, viscous sublayer included.
   const bool wall_function = prm.wall_function && !fluid_j && !free_slip_j;
   if (prm.viscosity == Viscosity::artificial) {
-    const Real approach =
-        prm.wall_viscosity_normal && !fluid_j ? wall_normal_approach<D>(vij, rij, P.boundary_normal[j]) : dot(vij, rij);
-    s += pair::artificial_viscosity(prm.artificial_viscosity, h, Real(0.5) * (Mi.sound_speed + Mj.sound_speed),
-                                    Real(0.5) * (rho_i + rho_j), m_j, approach, r2, eta2, F);
-    if (wall_function) return s * rij + wall_friction_pair<D>(P, prm, vi, rho_i, mu_i, j, rij, F);
-    return s * rij;
+    const bool normal = prm.wall_viscosity_normal && !fluid_j;
+    const Real approach = normal ? wall_normal_approach<D>(vij, rij, P.boundary_normal[j]) : dot(vij, rij);
+    const Real s_visc = pair::artificial_viscosity(prm.artificial_viscosity, h, Real(0.5) * (Mi.sound_speed + Mj.sound_speed),
+                                                  Real(0.5) * (rho_i + rho_j), m_j, approach, r2, eta2, F);
+    Vec<D> a;
+    if (normal) a = s * rij + s_visc * wall_normal_direction<D>(rij, P.boundary_normal[j]);
+    else a = (s + s_visc) * rij;
+    if (wall_function) return a + wall_friction_pair<D>(P, prm, vi, rho_i, mu_i, j, rij, F);
+    return a;
   }
   if (free_slip_j) return s * rij;  // a free-slip wall exerts no shear
   if (wall_function) return s * rij + wall_friction_pair<D>(P, prm, vi, rho_i, mu_i, j, rij, F);
@@ -778,6 +797,10 @@ struct MomentumPass {
     const std::uint32_t padded = (m + W - 1) / W * W;
     alignas(32) Real rho_j[kMaxNeighbours + W], p_j[kMaxNeighbours + W], m_j[kMaxNeighbours + W],
         c_j[kMaxNeighbours + W];
+    // The viscosity acts along r_ij (along_r = 1, dir = 0) or, for a wall pair with the normal
+    // approach, along r_ij's wall-normal part (along_r = 0, dir = that part): other pairs keep
+    // the bits they had (x 1, + 0).
+    alignas(32) Real along_r[kMaxNeighbours + W], dir[D][kMaxNeighbours + W];
     const Real c_i = Mi.sound_speed;
     // One sound speed for every material (and the walls'): no per-neighbour material lookups.
     const bool one_c = prm.uniform_sound_speed;
@@ -786,11 +809,17 @@ struct MomentumPass {
       const std::uint32_t j = valid ? nb[k] : i;
       if (!valid) g.set_pad(k, h);
       g.set_vr(k, P, vi, j);
+      along_r[k] = Real(1);
+      for (int a = 0; a < D; ++a) dir[a][k] = Real(0);
       if (prm.wall_viscosity_normal && valid && P.kind[j] != std::uint8_t(Kind::fluid)) {
-        // The approach along the wall's normal (momentum_pair): vr is read by the viscosity only.
+        // The approach along the wall's normal and the force along it (momentum_pair): vr and
+        // dir are read by the viscosity only.
         Vec<D> rij;
         for (int a = 0; a < D; ++a) rij[a] = g.r[a][k];
         g.vr[k] = wall_normal_approach<D>(vi - P.velocity[j], rij, P.boundary_normal[j]);
+        const Vec<D> d = wall_normal_direction<D>(rij, P.boundary_normal[j]);
+        for (int a = 0; a < D; ++a) dir[a][k] = d[a];
+        along_r[k] = Real(0);
       }
       rho_j[k] = P.density[j];
       p_j[k] = P.pressure[j];
@@ -813,8 +842,8 @@ struct MomentumPass {
         const Real vr = g.vr[k];
         const Real visc_full = ah * c_mean * vr / ((r2 + eta2) * Real(0.5) * (rho_i + rho_j[k]));
         const Real visc = vr < Real(0) ? visc_full : Real(0);
-        const Real s = m_j[k] * F * (press + visc);
-        for (int a = 0; a < D; ++a) sum[a][l] += s * g.r[a][k];
+        const Real s = m_j[k] * F * (press + visc * along_r[k]), sv = m_j[k] * F * visc;
+        for (int a = 0; a < D; ++a) sum[a][l] += s * g.r[a][k] + sv * dir[a][k];
       }
     }
     for (int a = 0; a < D; ++a) {

@@ -202,7 +202,9 @@ void check_run_state(const nlohmann::json& state, const fs::path& file) {
                       {"inflow", false, true},         {"outflow", false, true},        {"splits", false, true},
                       {"daughters", false, true},      {"splits_refused", false, true},
                       {"smallest_smoothing_length", false, false}, {"checkpoint_every", false, false},
-                      {"fluid_particle_steps", false, true}, {"wall_put_backs", false, true}};
+                      {"fluid_particle_steps", false, true}, {"wall_put_backs", false, true},
+                      {"wall_constraint_impulse_x", false, false}, {"wall_constraint_impulse_y", false, false},
+                      {"wall_constraint_impulse_z", false, false}, {"wall_constraint_energy", false, false}};
   for (const Key& k : keys) {
     if (!state.contains(k.name)) {
       if (k.required) bad(file, "'state' has no '" + std::string(k.name) + "'");
@@ -397,6 +399,11 @@ class Writers final : public fsi::Observer {
     state["particle_steps"] = sim.particle_steps();
     state["fluid_particle_steps"] = sim.fluid_particle_steps();
     state["wall_put_backs"] = sim.wall_put_backs();
+    const sph::WallConstraintTotals constraint = sim.wall_constraint_totals();
+    state["wall_constraint_impulse_x"] = constraint.impulse[0];
+    state["wall_constraint_impulse_y"] = constraint.impulse[1];
+    state["wall_constraint_impulse_z"] = constraint.impulse[2];
+    state["wall_constraint_energy"] = constraint.energy;
     state["inflow"] = sim.inflow();
     state["outflow"] = sim.outflow();
     if (!sim.scene().transitions.empty()) {
@@ -894,6 +901,12 @@ nlohmann::json run_scene(const RunRequest& request) {
       sim.restore_open_boundary_counts(state.value("inflow", std::uint64_t(0)), state.value("outflow", std::uint64_t(0)));
       sim.restore_fluid_particle_steps(state.value("fluid_particle_steps", std::uint64_t(0)));
       sim.restore_wall_put_backs(state.value("wall_put_backs", std::uint64_t(0)));
+      sph::WallConstraintTotals constraint;
+      constraint.impulse[0] = state.value("wall_constraint_impulse_x", 0.0);
+      constraint.impulse[1] = state.value("wall_constraint_impulse_y", 0.0);
+      constraint.impulse[2] = state.value("wall_constraint_impulse_z", 0.0);
+      constraint.energy = state.value("wall_constraint_energy", 0.0);
+      sim.restore_wall_constraint_totals(constraint);
       sph::SplitCounts splits;
       splits.splits = state.value("splits", std::size_t(0));
       splits.daughters = state.value("daughters", std::size_t(0));
@@ -942,6 +955,15 @@ nlohmann::json run_scene(const RunRequest& request) {
   // What impermeable walls did to get there: fluid particles put back on a wall's surface, summed
   // over every drift (a particle counts once per drift).
   report["fluid_put_back_on_walls"] = sim.wall_put_backs();
+  // And what they took from the fluid: the momentum walls and structures received for it (booked
+  // on their particles, so forces.csv and moving bodies include it) and the kinetic energy.
+  {
+    const sph::WallConstraintTotals constraint = sim.wall_constraint_totals();
+    nlohmann::json impulse = nlohmann::json::array();
+    for (int a = 0; a < scene.dimensions; ++a) impulse.push_back(constraint.impulse[a]);
+    report["wall_constraint_impulse"] = impulse;
+    report["wall_constraint_energy"] = constraint.energy;
+  }
   if (!scene.open_boundaries.empty()) {
     report["buffer_particles"] = sim.summary().buffer_particles;
     report["inflow_particles"] = sim.inflow();

@@ -46,7 +46,8 @@ class CpuBackend final : public Backend {
     store_ = &store;
     ids_ = ids;
     params_ = params;
-    wall_put_backs_ = 0;
+    put_backs_[0] = put_backs_[1] = 0;
+    constraint_totals_ = {};
     omp_set_num_threads(threads_);
     layout_ = GridLayout::make(domain, params.dimensions, 2.0 * params.smoothing_length * max_h_ratio());
     cell_count_ = layout_.cell_count;
@@ -79,7 +80,9 @@ class CpuBackend final : public Backend {
     if (params_.dimensions == 2) drift_impl<2>(Real(dt));
     else drift_impl<3>(Real(dt));
   }
-  std::uint64_t wall_put_backs() override { return wall_put_backs_; }
+  std::uint64_t wall_put_backs() override { return put_backs_[0]; }
+  WallConstraintTotals wall_constraint_totals() override { return constraint_totals_; }
+  void restore_wall_constraint_totals(const WallConstraintTotals& t) override { constraint_totals_ = t; }
 
   OpenBoundaryCounts update_open_boundaries() override {
     const OpenBoundaryCounts c = sph::update_open_boundaries(*store_, ids_, params_);
@@ -345,6 +348,10 @@ class CpuBackend final : public Backend {
     if (ids_.split_fresh >= 0) v.split_fresh = s.data<std::uint8_t>(ids_.split_fresh);
     if (ids_.viscous_load >= 0) v.viscous_load = s.data<Vec<D>>(ids_.viscous_load);
     if (ids_.viscous_pending >= 0) v.viscous_pending = s.data<Vec<D>>(ids_.viscous_pending);
+    if (ids_.put_back_impulse >= 0) v.put_back_impulse = s.data<Vec<D>>(ids_.put_back_impulse);
+    if (ids_.put_back_from >= 0) v.put_back_from = s.data<std::uint32_t>(ids_.put_back_from);
+    if (ids_.constraint_force >= 0) v.constraint_force = s.data<Vec<D>>(ids_.constraint_force);
+    if (ids_.constraint_power >= 0) v.constraint_power = s.data<Real>(ids_.constraint_power);
     v.count = std::uint32_t(s.size());
     if (soa_valid_) {
       v.position_soa = soa_.data();
@@ -479,9 +486,22 @@ class CpuBackend final : public Backend {
   void drift_impl(Real dt) {
     parallel_for(std::uint32_t(store_->size()),
                  DriftPass<D>{view<D>(), dt, params_.materials[params_.wall_material].eos.no_tension_density(), params_});
-    if (params_.wall_constraint)
-      parallel_for(std::uint32_t(store_->size()),
-                   WallConstraintPass<D>{view<D>(), grid<D>(), params_, list(false), &wall_put_backs_});
+    if (!params_.wall_constraint) return;
+    const std::uint32_t n = std::uint32_t(store_->size());
+    put_backs_[1] = put_backs_[0];
+    parallel_for(n, WallConstraintPass<D>{view<D>(), grid<D>(), params_, list(false), &put_backs_[0]});
+    const ParticleView<D> P = view<D>();
+    parallel_for(n, WallConstraintLoadPass<D>{P, grid<D>(), params_, Real(1) / dt, put_backs_});
+    if (put_backs_[0] == put_backs_[1]) return;
+    // The drift's impulse and energy into the run's totals (fixed-order sums: any thread count).
+    auto boundary = [P](std::uint32_t b) { return WallConstraintPass<D>::boundary(P.kind[b]); };
+    for (int a = 0; a < D; ++a)
+      constraint_totals_.impulse[a] += double(dt) * fixed_order_sum(n, [&](std::uint32_t b) {
+        return boundary(b) ? double(P.constraint_force[b][a]) : 0.0;
+      });
+    constraint_totals_.energy += double(dt) * fixed_order_sum(n, [&](std::uint32_t b) {
+      return boundary(b) ? double(P.constraint_power[b]) : 0.0;
+    });
   }
 
   template <int D>
@@ -557,7 +577,8 @@ class CpuBackend final : public Backend {
   }
 
   int threads_;
-  unsigned long long wall_put_backs_ = 0;
+  unsigned long long put_backs_[2] = {0, 0};  // WallConstraintPass's put-backs since bind; [1]: before this drift
+  WallConstraintTotals constraint_totals_;
   ParticleStore* store_ = nullptr;
   FieldIds ids_;
   PhysicsParams params_;

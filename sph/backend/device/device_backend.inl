@@ -177,14 +177,20 @@ struct HealthPass {
 // The health check, the speeds and the particle count in one reduction (Backend::check_step).
 // After a neighbour update inside the step the count is the sort's kept particles, read on the
 // device (`kept`, else all n): the particles past it left the domain and are not reported on.
+// With a drift's put-backs to report, the same reduction sums their booked force and power over
+// walls and structures (WallConstraintLoadPass; the fields follow the sort).
 struct StepReport {
   SpeedPair speed;
   std::uint32_t bad;   // the first unhealthy particle, kHealthy if none
   std::uint32_t kept;  // particles in the domain
+  double load[4];      // sum of constraint_force (D components) and constraint_power
 };
 struct CombineStepReport {
   TURBID_HD StepReport operator()(const StepReport& a, const StepReport& b) const {
-    return {MaxSpeedPair{}(a.speed, b.speed), a.bad < b.bad ? a.bad : b.bad, a.kept < b.kept ? b.kept : a.kept};
+    return {MaxSpeedPair{}(a.speed, b.speed),
+            a.bad < b.bad ? a.bad : b.bad,
+            a.kept < b.kept ? b.kept : a.kept,
+            {a.load[0] + b.load[0], a.load[1] + b.load[1], a.load[2] + b.load[2], a.load[3] + b.load[3]}};
   }
 };
 template <int D>
@@ -193,10 +199,17 @@ struct StepReportPass {
   HealthPass<D> health;
   const std::uint32_t* kept;  // nullptr: all n are kept
   std::uint32_t n;
+  bool constraint;            // sum the booked put-backs too
   TURBID_HD StepReport operator()(std::uint32_t i) const {
     const std::uint32_t k = kept ? *kept : n;
-    if (i >= k) return {{0.f, 0.f}, kHealthy, k};
-    return {speed(i), health(i), k};
+    if (i >= k) return {{0.f, 0.f}, kHealthy, k, {0, 0, 0, 0}};
+    StepReport r{speed(i), health(i), k, {0, 0, 0, 0}};
+    const ParticleView<D>& P = speed.P;
+    if (constraint && WallConstraintPass<D>::boundary(P.kind[i])) {
+      for (int a = 0; a < D; ++a) r.load[a] = double(P.constraint_force[i][a]);
+      r.load[3] = double(P.constraint_power[i]);
+    }
+    return r;
   }
 };
 
@@ -382,8 +395,10 @@ class DeviceBackend final : public Backend {
     cell_start_.clear();
     fluid_before_.allocate((cell_count_ + 1) * sizeof(std::uint32_t));
     fluid_before_.clear();
-    put_backs_.allocate(sizeof(unsigned long long));
+    put_backs_.allocate(2 * sizeof(unsigned long long));
     put_backs_.clear();
+    constraint_dt_ = 0;
+    constraint_totals_ = {};
     allocate_fields();
     upload();
   }
@@ -425,11 +440,21 @@ class DeviceBackend final : public Backend {
     else launch("DriftPass<3>", n_, DriftPass<3>{view<3>(), Real(dt), wall_rho_min, params_});
     if (!params_.wall_constraint) return;
     auto* put_backs = put_backs_.as<unsigned long long>();
-    if (params_.dimensions == 2)
+    launch("MarkPutBacksPass", 1, MarkPutBacksPass{put_backs});
+    const Real inv_dt = Real(1) / Real(dt);
+    if (params_.dimensions == 2) {
       launch("WallConstraintPass<2>", n_, WallConstraintPass<2>{view<2>(), grid<2>(), params_, NeighbourList{}, put_backs});
-    else
+      launch("WallConstraintLoadPass<2>", n_, WallConstraintLoadPass<2>{view<2>(), grid<2>(), params_, inv_dt, put_backs});
+    } else {
       launch("WallConstraintPass<3>", n_, WallConstraintPass<3>{view<3>(), grid<3>(), params_, NeighbourList{}, put_backs});
+      launch("WallConstraintLoadPass<3>", n_, WallConstraintLoadPass<3>{view<3>(), grid<3>(), params_, inv_dt, put_backs});
+    }
+    // Summed into the totals by the step's check (one reduction: no wait here).
+    constraint_dt_ = double(Real(dt));
   }
+
+  WallConstraintTotals wall_constraint_totals() override { return constraint_totals_; }
+  void restore_wall_constraint_totals(const WallConstraintTotals& t) override { constraint_totals_ = t; }
 
   std::uint64_t wall_put_backs() override {
     unsigned long long n = 0;
@@ -804,6 +829,10 @@ class DeviceBackend final : public Backend {
     if (ids_.split_fresh >= 0) v.split_fresh = static_cast<std::uint8_t*>(field(ids_.split_fresh));
     if (ids_.viscous_load >= 0) v.viscous_load = static_cast<Vec<D>*>(field(ids_.viscous_load));
     if (ids_.viscous_pending >= 0) v.viscous_pending = static_cast<Vec<D>*>(field(ids_.viscous_pending));
+    if (ids_.put_back_impulse >= 0) v.put_back_impulse = static_cast<Vec<D>*>(field(ids_.put_back_impulse));
+    if (ids_.put_back_from >= 0) v.put_back_from = static_cast<std::uint32_t*>(field(ids_.put_back_from));
+    if (ids_.constraint_force >= 0) v.constraint_force = static_cast<Vec<D>*>(field(ids_.constraint_force));
+    if (ids_.constraint_power >= 0) v.constraint_power = static_cast<Real*>(field(ids_.constraint_power));
     v.count = n_;
     return v;
   }
@@ -1009,9 +1038,15 @@ class DeviceBackend final : public Backend {
     }
     const ParticleView<D> P = view<D>();
     const std::uint32_t* kept = count_pending_ ? kept_on_device() : nullptr;
+    const bool constraint = constraint_dt_ > 0;
     const StepReport r =
-        reduce(n_, StepReportPass<D>{SpeedPass<D>{P}, HealthPass<D>::make(P, params_, limit), kept, n_},
-               StepReport{{0.f, 0.f}, kHealthy, 0u}, CombineStepReport{});
+        reduce(n_, StepReportPass<D>{SpeedPass<D>{P}, HealthPass<D>::make(P, params_, limit), kept, n_, constraint},
+               StepReport{{0.f, 0.f}, kHealthy, 0u, {0, 0, 0, 0}}, CombineStepReport{});
+    if (constraint) {
+      for (int a = 0; a < D; ++a) constraint_totals_.impulse[a] += constraint_dt_ * r.load[a];
+      constraint_totals_.energy += constraint_dt_ * r.load[3];
+      constraint_dt_ = 0;  // a drift's put-backs are counted once (a split's check comes again)
+    }
     if (count_pending_) unreported_removed_ += take_count(r.kept);
     c.removed = std::exchange(unreported_removed_, 0);
     if (r.bad != kHealthy) c.issue = describe_unhealthy<D>(r.bad);
@@ -1063,7 +1098,9 @@ class DeviceBackend final : public Backend {
   DeviceBuffer scratch_;              // gather target, capacity x widest field
   DeviceBuffer cell_start_, keys_, order_;
   DeviceBuffer fluid_before_;  // cell_count + 1: fluid particles in the cells before each cell
-  DeviceBuffer put_backs_;     // one counter: WallConstraintPass's put-backs since bind
+  DeviceBuffer put_backs_;     // WallConstraintPass's put-backs since bind; [1]: before this drift
+  double constraint_dt_ = 0;   // > 0: the last drift's booked put-backs await the step's check
+  WallConstraintTotals constraint_totals_;
   DeviceBuffer split_slots_, split_rule_, split_first_;  // splitting only, from the first split
   DeviceBuffer relax_zone_, relax_shift_;  // relaxation after a split, from the first one
   DeviceBuffer placements_;  // moving structures' BodyPlacement, one per structure
