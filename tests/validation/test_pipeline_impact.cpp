@@ -9,8 +9,14 @@
 //     (measured -8.6% at D/dx = 4, the CI spacing, where the gap under the pipe is two particle
 //     rows; +2.5% at D/dx = 6, full mode).
 //  2. Causality: the drag peak comes after the debris front (probe debris_front + dx/2) has reached
-//     the pipe's upstream face, and it stands above the still-water noise (the RMS of Fx over
-//     0.3-1.2 s) by more than a factor of 5 (measured 13.4 at D/dx = 4, 12.5 at D/dx = 6).
+//     the pipe's upstream face, and it stands above the still-water noise (the RMS over 0.3-1.2 s)
+//     by more than a factor of 5. The drag is the 0.05 s centred moving mean of Fx, what a force
+//     transducer with that window reads and what tools/pipeline_study reports: since the
+//     impermeable-wall pass's impulse is booked on the pipe (issue #47 item 1) a put-back reaches
+//     the load as one step's J/dt, and a 100 Hz sample that holds one reads it as a spike (raw
+//     samples: 340 N/m at 1.84 s against a filtered peak of 102 N/m at 2.43 s). Measured on the
+//     filtered drag at D/dx = 4: 17.9 x the noise (5.7 N/m). Before the booking, on raw samples:
+//     13.4 at D/dx = 4, 12.5 at D/dx = 6.
 //  3. Mass: splitting conserves mass (each daughter m/4): debris + turbidity mass (probes) constant
 //     to 1e-9 of it at every output, and the fluid's total mass to 1e-12.
 //  4. The transition happens: some of the debris has become turbidity by the end.
@@ -23,6 +29,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <vector>
 
 #include "validation_support.hpp"
 
@@ -53,13 +60,23 @@ TEST(ValidationPipelineImpact, DebrisFlowOnASuspendedPipeline2D) {
   ASSERT_EQ(fx.size(), t.size());
   ASSERT_EQ(fy.size(), t.size());
 
+  // The drag over a centred 0.05 s window (see 2. above).
+  std::vector<double> drag(t.size());
+  for (std::size_t k = 0, lo = 0, hi = 0; k < t.size(); ++k) {
+    while (lo < t.size() && t[lo] < t[k] - 0.025) ++lo;
+    while (hi < t.size() && t[hi] <= t[k] + 0.025) ++hi;
+    double sum = 0;
+    for (std::size_t j = lo; j < hi; ++j) sum += fx[j];
+    drag[k] = sum / double(hi - lo);
+  }
+
   // 1. Archimedes in still water.
   double lift = 0, noise = 0;
   int n = 0;
   for (std::size_t k = 0; k < t.size(); ++k) {
     if (t[k] < kStillFrom || t[k] > kStillTo) continue;
     lift += fy[k];
-    noise += fx[k] * fx[k];
+    noise += drag[k] * drag[k];
     ++n;
   }
   ASSERT_GT(n, 10);
@@ -71,7 +88,7 @@ TEST(ValidationPipelineImpact, DebrisFlowOnASuspendedPipeline2D) {
   EXPECT_NEAR(lift, archimedes, buoyancy_tolerance * archimedes);
 
   // 2. The drag peak after the debris arrives, well above the noise.
-  const auto peak = std::max_element(fx.begin(), fx.end()) - fx.begin();
+  const auto peak = std::max_element(drag.begin(), drag.end()) - drag.begin();
   const auto& pt = probes["time"];
   const auto& front = probes["debris_front"];
   double arrival = NAN;
@@ -80,11 +97,12 @@ TEST(ValidationPipelineImpact, DebrisFlowOnASuspendedPipeline2D) {
       arrival = pt[k];
       break;
     }
-  std::printf("[ measured ] debris reaches the pipe at %.2f s; peak drag %.1f N/m at %.2f s (%.1f x the noise)\n", arrival,
-              fx[peak], t[peak], fx[peak] / noise);
+  std::printf("[ measured ] debris reaches the pipe at %.2f s; peak drag (0.05 s mean) %.1f N/m at %.2f s (%.1f x the "
+              "noise); largest raw sample %.1f N/m\n",
+              arrival, drag[peak], t[peak], drag[peak] / noise, *std::max_element(fx.begin(), fx.end()));
   ASSERT_TRUE(std::isfinite(arrival)) << "the debris never reached the pipe";
   EXPECT_GE(t[peak], arrival - 0.05) << "the largest drag comes before the debris";
-  EXPECT_GT(fx[peak], 5 * noise);
+  EXPECT_GT(drag[peak], 5 * noise);
 
   // 3. Mass through the transition.
   const auto& md = probes["debris_mass"];
