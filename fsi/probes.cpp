@@ -13,33 +13,51 @@
 namespace turbid::fsi {
 namespace {
 
-// Sample points of a sensor face centred on `c` and normal to `normal`: a segment of length `d` in
-// 2D, a disc of diameter `d` in 3D, sampled at about dx / 4 (9 to 33 points across), each point
-// the centre of an equal share of the face's area.
+// A sensor face's frame: the unit normal n and, in the face, the unit vectors a (and b in 3D);
+// in 2D a = (-n_y, n_x).
+struct FaceFrame {
+  std::array<double, 3> n{0, 0, 0}, a{0, 0, 0}, b{0, 0, 0};
+};
+
 template <int D>
-std::vector<std::array<double, 3>> sensor_face_points(const std::array<double, 3>& c, std::array<double, 3> normal,
-                                                      double d, double dx) {
+FaceFrame face_frame(std::array<double, 3> normal) {
   double len = 0;
   for (int k = 0; k < D; ++k) len += normal[std::size_t(k)] * normal[std::size_t(k)];
   len = std::sqrt(len);
   for (int k = 0; k < D; ++k) normal[std::size_t(k)] /= len;
-  const int across = std::min(33, std::max(9, int(std::ceil(4 * d / dx))));
-  std::vector<std::array<double, 3>> out;
+  FaceFrame f;
+  f.n = normal;
   if constexpr (D == 2) {
-    const std::array<double, 3> t{-normal[1], normal[0], 0};
-    for (int i = 0; i < across; ++i) {
-      const double s = d * ((i + 0.5) / across - 0.5);
-      out.push_back({c[0] + s * t[0], c[1] + s * t[1], 0});
-    }
+    f.a = {-normal[1], normal[0], 0};
   } else {
-    // Two unit vectors in the face.
     std::array<double, 3> a = std::abs(normal[0]) < 0.9 ? std::array<double, 3>{1, 0, 0} : std::array<double, 3>{0, 1, 0};
     const double an = a[0] * normal[0] + a[1] * normal[1] + a[2] * normal[2];
     for (int k = 0; k < 3; ++k) a[std::size_t(k)] -= an * normal[std::size_t(k)];
     const double al = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
     for (auto& v : a) v /= al;
-    const std::array<double, 3> b{normal[1] * a[2] - normal[2] * a[1], normal[2] * a[0] - normal[0] * a[2],
-                                  normal[0] * a[1] - normal[1] * a[0]};
+    f.a = a;
+    f.b = {normal[1] * a[2] - normal[2] * a[1], normal[2] * a[0] - normal[0] * a[2], normal[0] * a[1] - normal[1] * a[0]};
+  }
+  return f;
+}
+
+// Sample points of a sensor face centred on `c` and normal to `normal`: a segment of length `d` in
+// 2D, a disc of diameter `d` in 3D, sampled at about dx / 4 (9 to 33 points across), each point
+// the centre of an equal share of the face's area.
+template <int D>
+std::vector<std::array<double, 3>> sensor_face_points(const std::array<double, 3>& c, const std::array<double, 3>& normal,
+                                                      double d, double dx) {
+  const FaceFrame f = face_frame<D>(normal);
+  const int across = std::min(33, std::max(9, int(std::ceil(4 * d / dx))));
+  std::vector<std::array<double, 3>> out;
+  if constexpr (D == 2) {
+    for (int i = 0; i < across; ++i) {
+      const double s = d * ((i + 0.5) / across - 0.5);
+      out.push_back({c[0] + s * f.a[0], c[1] + s * f.a[1], 0});
+    }
+  } else {
+    const auto& a = f.a;
+    const auto& b = f.b;
     // A square grid of `across` x `across` cells over the disc's bounding square; the cell centres
     // inside the disc, each an equal share of its area.
     for (int i = 0; i < across; ++i)
@@ -50,6 +68,67 @@ std::vector<std::array<double, 3>> sensor_face_points(const std::array<double, 3
       }
   }
   return out;
+}
+
+// A load cell behind a wall (probe type wall_load): the pressure the fluid's force on the wall and
+// structure particles behind a face on the wall surface gives, p = -sum_b w_b F_b . n / A. F_b is
+// the force of the last force pass on b (StructureForcePass: the exact reaction of the fluid's pair
+// accelerations, plus the impermeable-wall pass's impulse of the last drift over its step); n the
+// face's unit normal into the fluid; A its area (d per metre in 2D, pi d^2 / 4 in 3D). b counts
+// when it lies behind the face by at most 2 h_max + dx (every layer the fluid's kernel reaches),
+// with the share w_b of its lattice cell (dx wide, dx x dx in 3D, centred on b's projection on the
+// face) that lies on the face: a uniform pressure then reads exactly at any spacing and face size.
+// The face sits on the wall surface, not a spacing in front of it, so it is the same surface at
+// every spacing. Unfiltered: the reading of the last force pass (sampled each step with
+// `probes_every: step`, a bandwidth of 1 / (2 dt)). nan when no wall particle is behind the face.
+template <int D>
+double wall_load(const Scene& scene, const ProbeSpec& probe, const sph::ParticleStore& s, const sph::FieldIds& ids,
+                 const sph::PhysicsParams& params) {
+  using V = sph::Vec<D>;
+  if (ids.structure_force < 0) return std::nan("");
+  const V* x = s.data<V>(ids.position);
+  const V* force = s.data<V>(ids.structure_force);
+  const std::uint8_t* kind = s.data<std::uint8_t>(ids.kind);
+  const FaceFrame f = face_frame<D>(probe.sensor_normal);
+  const double dx = scene.particle_spacing, d = probe.sensor_diameter, depth = 2 * params.max_smoothing_length + dx;
+  // Share of [s - dx/2, s + dx/2] (2D), or of the dx x dx square around (u, v) (3D, 8 x 8 points),
+  // on the face.
+  auto share = [&](double u, double v) {
+    if constexpr (D == 2) {
+      const double lo = std::max(u - 0.5 * dx, -0.5 * d), hi = std::min(u + 0.5 * dx, 0.5 * d);
+      return hi > lo ? (hi - lo) / dx : 0.0;
+    } else {
+      constexpr int k = 8;
+      int in = 0;
+      for (int i = 0; i < k; ++i)
+        for (int j = 0; j < k; ++j) {
+          const double uu = u + dx * ((i + 0.5) / k - 0.5), vv = v + dx * ((j + 0.5) / k - 0.5);
+          in += uu * uu + vv * vv <= 0.25 * d * d;
+        }
+      return double(in) / (k * k);
+    }
+  };
+  double normal_force = 0;
+  bool behind = false;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (kind[i] != std::uint8_t(sph::Kind::wall) && kind[i] != std::uint8_t(sph::Kind::structure)) continue;
+    double r[3] = {0, 0, 0};
+    for (int k = 0; k < D; ++k) r[k] = double(x[i][k]) - probe.point[std::size_t(k)];
+    double rn = 0, u = 0, v = 0, fn = 0;
+    for (int k = 0; k < D; ++k) {
+      rn += r[k] * f.n[std::size_t(k)];
+      u += r[k] * f.a[std::size_t(k)];
+      v += r[k] * f.b[std::size_t(k)];
+      fn += double(force[i][k]) * f.n[std::size_t(k)];
+    }
+    if (rn >= 0 || rn < -depth) continue;
+    const double w = share(u, v);
+    if (w <= 0) continue;
+    behind = true;
+    normal_force += w * fn;
+  }
+  const double area = D == 2 ? d : 0.25 * 3.14159265358979323846 * d * d;
+  return behind ? -normal_force / area : std::nan("");
 }
 
 // A wave gauge's reading at a station: the fluid fraction f(z) = sum_j W(|x_j - (X, z)|, h) V_j
@@ -260,6 +339,8 @@ double evaluate(const Scene& scene, const ProbeSpec& probe, const sph::ParticleS
       }
       return std::isfinite(best) ? best + 0.5 * dx : std::nan("");  // no fluid at the station: NaN
     }
+    case ProbeSpec::Type::wall_load:
+      return wall_load<D>(scene, probe, s, ids, params);
     case ProbeSpec::Type::material_mass: {
       // Splitting moves mass from one material to another: with transitions the sum over the
       // materials involved is what stays constant.
@@ -286,6 +367,7 @@ const char* probe_unit(ProbeSpec::Type t, int dimensions) {
     case ProbeSpec::Type::surface_elevation: return "m";
     case ProbeSpec::Type::highest_particle: return "m";
     case ProbeSpec::Type::material_mass: return two_d ? "kg/m" : "kg";
+    case ProbeSpec::Type::wall_load: return "Pa";
   }
   return "";
 }

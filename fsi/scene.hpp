@@ -232,6 +232,11 @@ struct ProbeSpec {
     // the highest fluid particle (of `material`) horizontally within dx of the station plus dx/2 [m]:
     // surface_elevation's definition before issue #25 (a splash or jet reads as water level)
     highest_particle,
+    // pressure as a load cell behind a wall reads it [Pa]: the fluid's force on the wall and
+    // structure particles behind a face on the wall surface (centred on `point`, normal
+    // `sensor_normal` into the fluid, diameter `sensor_diameter`: a segment in 2D, a disc in 3D),
+    // pair forces and the impermeable-wall pass's impulse, normal to the face, over its area
+    wall_load,
   };
   std::string name;
   Type type = Type::max_speed;
@@ -245,7 +250,8 @@ struct ProbeSpec {
   double min_kernel_sum = 0.2;
   // pressure as a wall sensor reads it: the average over a face of this diameter [m] centred on
   // `point` and normal to `sensor_normal` (a segment in 2D, a disc in 3D), air counted at ambient 0
-  // (fsi/probes.cpp); min_kernel_sum does not apply. 0: the pressure at the point.
+  // (fsi/probes.cpp); min_kernel_sum does not apply. 0: the pressure at the point. wall_load: its
+  // face (required).
   double sensor_diameter = 0;
   Vec3d sensor_normal{1, 0, 0};
   SourceLocation where;

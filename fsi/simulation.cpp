@@ -756,6 +756,7 @@ sph::PhysicsParams physics_params(const Scene& scene) {
   p.wall_constraint_reach = sph::Real(scene.particle_spacing);
   for (const auto& w : scene.walls) p.free_slip_walls = p.free_slip_walls || w.free_slip;
   p.body_count = int(scene.structures.size());
+  for (const auto& probe : scene.probes) p.wall_loads = p.wall_loads || probe.type == ProbeSpec::Type::wall_load;
   p.zone_count = int(scene.open_boundaries.size());
   for (std::size_t k = 0; k < scene.open_boundaries.size(); ++k) {
     const auto& ob = scene.open_boundaries[k];

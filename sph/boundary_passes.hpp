@@ -290,6 +290,8 @@ struct BufferPass {
 // Force of the fluid on every structure particle b: minus the sum over fluid neighbours i of
 // m_i times the acceleration the momentum pass gives i because of b (momentum_pair, the same
 // function with the same arguments), so the forces on structures and fluid cancel to rounding.
+// With PhysicsParams::wall_loads, on every wall particle too (load sensors on walls). The
+// implicit viscous reaction (viscous_load) is kept for structures only.
 template <int D, class K, bool UniformH>
 struct StructureForcePass {
   ParticleView<D> P;
@@ -298,7 +300,8 @@ struct StructureForcePass {
 
   TURBID_HD void operator()(std::uint32_t b) const {
     Vec<D> f = Vec<D>::zero();
-    if (P.kind[b] != std::uint8_t(Kind::structure)) {
+    const bool wall = prm.wall_loads && P.kind[b] == std::uint8_t(Kind::wall);
+    if (P.kind[b] != std::uint8_t(Kind::structure) && !wall) {
       P.structure_force[b] = f;
       return;
     }

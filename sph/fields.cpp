@@ -36,8 +36,11 @@ FieldIds register_fields(ParticleStore& s, const PhysicsParams& p, bool structur
     f.viscous_velocity = s.add_field(
         {"viscous_velocity", "m/s", ScalarType::f32, d, false, p.implicit_viscosity, false, Carry::recompute});
   if (structures) {
-    const char* force_unit = d == 2 ? "N/m" : "N";
     f.body = s.add_field({"body", "", ScalarType::u8, 1, true, true, true, Carry::copy});
+  }
+  // The fluid's force on each structure particle, and on each wall particle with load sensors on walls.
+  if (structures || p.wall_loads) {
+    const char* force_unit = d == 2 ? "N/m" : "N";
     f.structure_force = s.add_field({"structure_force", force_unit, ScalarType::f32, d, true, false, false, Carry::recompute});
   }
   // Set once when the world is built; the placement reads them, so they follow the sort and are

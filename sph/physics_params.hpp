@@ -100,6 +100,9 @@ struct PhysicsParams {
   // (laminar viscosity, velocity gradient) leave them out.
   bool free_slip_walls = false;
   int body_count = 0;          // structures (particles of kind structure carry their index in `body`)
+  // Wall particles get the force of the fluid on them too (StructureForcePass, field
+  // structure_force), for load sensors on walls (fsi/probes.cpp, probe type wall_load).
+  bool wall_loads = false;
   int zone_count = 0;          // open-boundary buffer zones (buffer particles carry their index in `zone`)
   BufferZone zones[kMaxZones];
   Real diffusion_delta = Real(0.1);

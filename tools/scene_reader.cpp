@@ -1550,7 +1550,8 @@ void Reader::read_probes(const Value& v, fsi::Scene& scene) const {
   std::vector<std::string> material_names;
   for (const auto& m : scene.materials) material_names.push_back(m.name);
   const std::vector<std::string> types = {"front_position", "pressure", "max_speed", "kinetic_energy",
-                                          "fluid_particles", "surface_elevation", "material_mass", "highest_particle"};
+                                          "fluid_particles", "surface_elevation", "material_mass", "highest_particle",
+                                          "wall_load"};
   std::map<std::string, int> first_line;
   for (const Value& item : list(v)) {
     MapView m(*this, item, {"name", "type", "material", "axis", "point", "at", "min_kernel_sum", "sensor"});
@@ -1577,6 +1578,10 @@ void Reader::read_probes(const Value& v, fsi::Scene& scene) const {
     const bool station = probe.type == fsi::ProbeSpec::Type::surface_elevation ||
                          probe.type == fsi::ProbeSpec::Type::highest_particle;
     if (probe.type == fsi::ProbeSpec::Type::pressure) uses = {"point", "min_kernel_sum", "sensor"};
+    if (probe.type == fsi::ProbeSpec::Type::wall_load) {
+      uses = {"point", "sensor"};
+      m.need("sensor");  // the face is the sensor
+    }
     if (station) uses = {"material", "at"};
     if (probe.type == fsi::ProbeSpec::Type::material_mass) {
       uses = {"material"};
@@ -1598,7 +1603,8 @@ void Reader::read_probes(const Value& v, fsi::Scene& scene) const {
       const bool z_in_2d = dims == 2 && av->node.IsScalar() && av->node.Scalar() == "z";
       probe.axis = static_cast<int>(choice(*av, axes, z_in_2d ? "a 2D scene has no z axis" : ""));
     }
-    if (probe.type == fsi::ProbeSpec::Type::pressure) probe.point = point(m.need("point"), dims, "m");
+    if (probe.type == fsi::ProbeSpec::Type::pressure || probe.type == fsi::ProbeSpec::Type::wall_load)
+      probe.point = point(m.need("point"), dims, "m");
     if (auto kv = m.get("min_kernel_sum")) {
       probe.min_kernel_sum = number(*kv, non_negative());
       if (probe.min_kernel_sum >= 1)

@@ -17,8 +17,10 @@
 // about 1 minute). Both to t = 0.55 s (T = 3.1).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "validation_support.hpp"
 
@@ -29,22 +31,38 @@ TEST(ValidationDamBreakImpact, TheWaterNotItsSprayLoadsTheWall2D) {
   ASSERT_EQ(run.report.at("status").get<std::string>(), "completed") << run.report.dump(2);
   const auto c = turbid::validation::read_csv(run.out / "probes.csv");
   const std::vector<double>& t = c.at("time");
-  const std::vector<double>& p = c.at("sensor_15mm");
   const double rgh = 1000 * 9.81 * 0.3, to_T = std::sqrt(9.81 / 0.3);
-  std::size_t first = t.size();
-  for (std::size_t i = 0; i < t.size(); ++i)
-    if (std::isfinite(p[i]) && p[i] > 0.1 * rgh) {
-      first = i;
-      break;
+  // Arrival (first reading above 0.1 rho g H), first peak and impulse over 0.3 T after it, in rho g H.
+  struct Impact {
+    double arrival = NAN, peak = 0, impulse = 0;
+  };
+  auto impact_of = [&](const std::vector<double>& p) {
+    Impact r;
+    std::size_t first = t.size();
+    for (std::size_t i = 0; i < t.size(); ++i)
+      if (std::isfinite(p[i]) && p[i] > 0.1 * rgh) {
+        first = i;
+        break;
+      }
+    if (first == t.size()) return r;
+    r.arrival = t[first] * to_T;
+    for (std::size_t i = first; i + 1 < t.size(); ++i) {
+      const double T0 = t[i] * to_T, T1 = t[i + 1] * to_T;
+      const double a = std::isfinite(p[i]) ? p[i] / rgh : 0, b = std::isfinite(p[i + 1]) ? p[i + 1] / rgh : 0;
+      if (T0 <= r.arrival + 0.3) r.peak = std::max(r.peak, a);
+      if (T0 < r.arrival + 0.3) r.impulse += 0.5 * (a + b) * (T1 - T0);
     }
-  ASSERT_LT(first, t.size()) << "the water never reached the sensor";
-  const double arrival = t[first] * to_T;
-  double peak = 0, impulse = 0;
-  for (std::size_t i = first; i + 1 < t.size(); ++i) {
-    const double T0 = t[i] * to_T, T1 = t[i + 1] * to_T;
-    const double a = std::isfinite(p[i]) ? p[i] / rgh : 0, b = std::isfinite(p[i + 1]) ? p[i + 1] / rgh : 0;
-    if (T0 <= arrival + 0.3) peak = std::max(peak, a);
-    if (T0 < arrival + 0.3) impulse += 0.5 * (a + b) * (T1 - T0);
+    return r;
+  };
+  const Impact sensor = impact_of(c.at("sensor_15mm"));
+  ASSERT_TRUE(std::isfinite(sensor.arrival)) << "the water never reached the sensor";
+  const double arrival = sensor.arrival, peak = sensor.peak, impulse = sensor.impulse;
+  // The load cells behind the wall (issue #47 item 4): the same measures, printed for the record
+  // (docs/validation.md L); the goals of issue #25 are to be judged on them.
+  for (const char* name : {"load_3mm", "load_15mm"}) {
+    const Impact l = impact_of(c.at(name));
+    std::printf("[dam break impact H/dx=%.0f] %s: arrival T = %.3f, peak %.2f rho g H, impulse %.3f rho g H T\n",
+                0.3 / dx, name, l.arrival, l.peak, l.impulse);
   }
   std::printf("[dam break impact H/dx=%.0f] arrival T = %.3f, sensor peak %.2f rho g H, impulse %.3f rho g H T; "
               "wall %.0f s, %llu steps\n",

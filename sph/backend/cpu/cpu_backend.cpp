@@ -472,7 +472,7 @@ class CpuBackend final : public Backend {
       if (params_.rheology) parallel_for(P.count, RheologyPass<D, K, U>{P, G, params_});
       parallel_for(P.count, PressurePass<D>{P, params_});
       parallel_for(P.count, MomentumPass<D, K, U>{P, G, params_, list(true)});
-      if (params_.body_count > 0) parallel_for(P.count, StructureForcePass<D, K, U>{P, G, params_});
+      if (params_.body_count > 0 || params_.wall_loads) parallel_for(P.count, StructureForcePass<D, K, U>{P, G, params_});
     });
     list_valid_ = true;
   }

@@ -923,7 +923,8 @@ class DeviceBackend final : public Backend {
       if (params_.rheology) launch("RheologyPass", P.count, RheologyPass<D, K, U>{P, G, params_});
       launch("PressurePass", P.count, PressurePass<D>{P, params_});
       launch_pairs<D>("MomentumPass", P.count, MomentumPass<D, K, U>{P, G, params_, NeighbourList{}});
-      if (params_.body_count > 0) launch("StructureForcePass", P.count, StructureForcePass<D, K, U>{P, G, params_});
+      if (params_.body_count > 0 || params_.wall_loads)
+        launch("StructureForcePass", P.count, StructureForcePass<D, K, U>{P, G, params_});
     });
   }
 
