@@ -75,10 +75,33 @@ TURBID_HD TURBID_INLINE Vec<D> nearest_image(const PhysicsParams& prm, Vec<D> r)
   return r;
 }
 
+// Walls and structures: particles that stand for a solid (not fluid, not an open boundary's buffer).
+TURBID_HD inline bool solid_kind(std::uint8_t k) {
+  return k == std::uint8_t(Kind::wall) || k == std::uint8_t(Kind::structure);
+}
+
+// The smoothing length of the pair (i, j), i a fluid or buffer particle of smoothing length h_i.
+// Two particles of different smoothing lengths use the kernel of the mean h (symmetric in i and
+// j). A fluid particle and a wall or structure particle use the fluid particle's h: the solid
+// stands in for the fluid's own continuation beyond the surface, so its half of the kernel sum
+// must be the fluid's half-kernel. With the mean h a split daughter (h/2) next to a wall of the
+// parent's spacing (h) saw the wall through a kernel half again as wide as its fluid neighbours':
+// the wall's half of sum V grad W then fell short of the fluid's and the daughters settled behind
+// the wall surface (2.5e-3 put-backs per fluid particle-step in a resting layer of daughters on a
+// DBC floor; issue #47 item 2).
 template <int D, class K>
 TURBID_HD inline Real pair_h(const ParticleView<D>& P, const PhysicsParams& prm, bool uniform, Real h_i, std::uint32_t j) {
-  // A pair of different smoothing lengths uses the kernel of the mean h (symmetric in i and j).
-  return uniform ? prm.smoothing_length : Real(0.5) * (h_i + P.smoothing_length[j]);
+  if (uniform) return prm.smoothing_length;
+  return solid_kind(P.kind[j]) ? h_i : Real(0.5) * (h_i + P.smoothing_length[j]);
+}
+
+// The same for any i: a wall or structure particle i takes the fluid particle j's h.
+template <int D, class K>
+TURBID_HD inline Real pair_h(const ParticleView<D>& P, const PhysicsParams& prm, bool uniform, Real h_i, std::uint32_t i,
+                             std::uint32_t j) {
+  if (uniform) return prm.smoothing_length;
+  if (solid_kind(P.kind[i]) && !solid_kind(P.kind[j])) return P.smoothing_length[j];
+  return pair_h<D, K>(P, prm, false, h_i, j);
 }
 
 // An optional per-particle neighbour list (CPU backend): the momentum pass records, for each
@@ -412,7 +435,7 @@ struct ContinuityPass {
       }
     }
     for_each_neighbour<D>(P, G, L, prm, i, xi, [&](std::uint32_t j, const Vec<D>& rij, Real r2) {
-        const Real h = pair_h<D, K>(P, prm, UniformH, h_i, j);
+        const Real h = pair_h<D, K>(P, prm, UniformH, h_i, i, j);
         if (!UniformH && r2 >= Real(4) * h * h) return;
         const bool fluid_j = P.kind[j] == std::uint8_t(Kind::fluid);
         if (!fluid_i && !fluid_j) return;

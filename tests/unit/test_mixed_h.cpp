@@ -164,6 +164,7 @@ struct Lattice {
     v.mass = s.data<Real>(ids.mass);
     v.density = s.data<Real>(ids.density);
     v.smoothing_length = s.data<Real>(ids.smoothing_length);
+    v.kind = s.data<std::uint8_t>(ids.kind);  // pair_h tells fluid from walls by it
     v.count = std::uint32_t(s.size());
     return v;
   }
