@@ -2,13 +2,14 @@
 // break against a box on the floor (the SPHERIC benchmark 2 layout, mDBC walls). The surge hits the
 // box at t ~ 0.4 s and the near end wall at ~ 0.6 s, runs up and falls back over the box.
 //
-// A hard case for stability: the run reaches t = 1.5 s without a blow-up and loses no particle,
-// and the fluid's mass is constant to rounding. The walls' impermeability is printed, not
-// asserted: "no fluid behind the walls" holds by construction while the impermeable-wall pass is
-// on (before the pass 100 particles were behind at t = 1.5 s, dx = 0.03 m, deepest 3.1 dx), and the
-// pass's put-back rate misses the goal of issue #47 item 2 (1e-5 per fluid particle-step): 3.1e-3
-// at the CI spacing, where the box is 3.2 dx thick, thinner than the kernel's support (4 dx), and
-// the surge climbs it and the end wall (docs/validation.md, L, known misses).
+// A hard case for stability: the run reaches t = 1.5 s without a blow-up and loses no particle
+// (the fluid's mass, constant by construction when none is lost, is not asserted). The walls'
+// impermeability is printed, not asserted: "no fluid behind the walls" holds by construction while
+// the impermeable-wall pass is on (before the pass 100 particles were behind at t = 1.5 s,
+// dx = 0.03 m, deepest 3.1 dx), and the pass's put-back rate misses the goal of issue #47 item 2
+// (1e-5 per fluid particle-step): 3.1e-3 at the CI spacing, where the box is 3.2 dx thick,
+// thinner than the kernel's support (4 dx), and the surge climbs it and the end wall
+// (docs/validation.md, L, known misses).
 // Quick mode (CI): dx = 0.05 m (H/dx = 11, about 2 minutes on 2 cores); full mode (TURBID_FULL=1):
 // the scene's dx = 0.03 m (11-13 minutes). Both to t = 1.5 s.
 #include <gtest/gtest.h>
@@ -33,5 +34,4 @@ TEST(ValidationDamBreakBox, SurgeAroundTheBoxRunsToTheEndWithoutLosingFluid3D) {
                   (double(r.at("fluid_particles").get<std::uint64_t>()) * double(r.at("steps").get<std::uint64_t>())),
               r.at("wall_seconds").get<double>(), (unsigned long long)r.at("steps").get<std::uint64_t>());
   EXPECT_EQ(r.at("removed_particles").get<std::uint64_t>(), 0u);
-  EXPECT_LT(std::abs(r.at("fluid_mass_relative_change").get<double>()), 1e-12);
 }

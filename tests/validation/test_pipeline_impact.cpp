@@ -20,7 +20,8 @@
 //     pipe at 2.30 s, 38.7% of the soil turbidity). Before the booking, on raw samples: 13.4 at
 //     D/dx = 4, 12.5 at D/dx = 6.
 //  3. Mass: splitting conserves mass (each daughter m/4): debris + turbidity mass (probes) constant
-//     to 1e-9 of it at every output, and the fluid's total mass to 1e-12.
+//     to 1e-9 of it at every output. (The fluid's total mass is not asserted: with nothing removed
+//     it is constant by construction.)
 //  4. The transition happens: some of the debris has become turbidity by the end.
 //  5. The wall pass's put-back rate and impulse, printed (the scene misses the 1e-5 goal).
 // Quick mode (CI): the scene's spacing 0.025 m (D/dx = 4, about 2.5 minutes on 2 cores); full mode
@@ -114,7 +115,6 @@ TEST(ValidationPipelineImpact, DebrisFlowOnASuspendedPipeline2D) {
   double worst = 0;
   for (std::size_t k = 0; k < pt.size(); ++k) worst = std::max(worst, std::abs(md[k] + mt[k] - soil) / soil);
   EXPECT_LT(worst, 1e-9) << "debris + turbidity mass";
-  EXPECT_LT(std::abs(run.report.at("fluid_mass_relative_change").get<double>()), 1e-12);
 
   // 4. Some debris became turbidity.
   std::printf("[ measured ] turbidity at the end: %.1f%% of the soil; %s splits\n", 100 * mt.back() / soil,
