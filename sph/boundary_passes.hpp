@@ -209,7 +209,7 @@ struct MdbcPass {
 
   TURBID_HD void operator()(std::uint32_t b) const {
     const std::uint8_t kind = P.kind[b];
-    if (kind != std::uint8_t(Kind::wall) && kind != std::uint8_t(Kind::structure)) return;
+    if (!solid_kind(kind)) return;
     const Real rho0 = prm.materials[prm.wall_material].eos.rest_density;
     const Vec<D> n = P.boundary_normal[b];
     const Real h_b = UniformH ? prm.smoothing_length : P.smoothing_length[b];
@@ -356,9 +356,7 @@ struct WallConstraintPass {
   NeighbourList L;
   unsigned long long* put_back = nullptr;  // fluid particles put back on a surface (one per drift)
 
-  TURBID_HD static bool boundary(std::uint8_t k) {
-    return k == std::uint8_t(Kind::wall) || k == std::uint8_t(Kind::structure);
-  }
+  TURBID_HD static bool boundary(std::uint8_t k) { return solid_kind(k); }
 
   // The surface of boundary particle j: unit normal n (its ghost offset's direction) and half the
   // offset's length (the surface lies there in front of x_j). False without an offset.

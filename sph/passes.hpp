@@ -563,8 +563,7 @@ struct ContinuityPass {
 // fluid velocity (viscous_velocity), every other particle its own.
 template <int D>
 TURBID_HD inline Vec<D> viscous_velocity_of(const ParticleView<D>& P, std::uint32_t j) {
-  const bool mirrored = P.viscous_velocity != nullptr &&
-                        (P.kind[j] == std::uint8_t(Kind::wall) || P.kind[j] == std::uint8_t(Kind::structure));
+  const bool mirrored = P.viscous_velocity != nullptr && solid_kind(P.kind[j]);
   return mirrored ? P.viscous_velocity[j] : P.velocity[j];
 }
 

@@ -130,13 +130,13 @@ ResumeRuns check_resume(const std::string& scene_text) {
 
   EXPECT_EQ(r.full.at("steps"), r.resumed.at("steps"));
   EXPECT_EQ(r.full.at("simulated_time").get<double>(), r.resumed.at("simulated_time").get<double>());
-  // run.json: counts (the wall constraint's put-backs, impulse and energy too: restored from the
-  // checkpoint, the resumed run adds to them in the same order), capacity,
+  // run.json: counts (the wall constraint's put-backs, their rate per fluid particle-step, impulse
+  // and energy too: restored from the checkpoint, the resumed run adds to them in the same order), capacity,
   // split totals, masses and momenta (exact: same bits, same sums).
   for (const char* key : {"particles", "particles_end", "removed_particles", "capacity", "splits", "daughters_created",
                           "splits_refused", "fluid_mass_start", "fluid_mass_end", "fluid_momentum_start",
-                          "fluid_momentum_end", "materials", "fluid_put_back_on_walls", "wall_constraint_impulse",
-                          "wall_constraint_energy"}) {
+                          "fluid_momentum_end", "materials", "fluid_put_back_on_walls", "fluid_put_backs_per_particle_step",
+                          "wall_constraint_impulse", "wall_constraint_energy"}) {
     EXPECT_EQ(r.full.contains(key), r.resumed.contains(key)) << key;
     if (r.full.contains(key)) {
       EXPECT_EQ(r.full.at(key), r.resumed.at(key)) << "run.json '" << key << "' after resume";
